@@ -1,0 +1,62 @@
+//! Subcommands. Every `run` returns `CmdResult`; a `Failure` carries the
+//! message shown to the user and the exit code (2 = bad input).
+
+pub mod inspect;
+pub mod robot;
+pub mod rules;
+pub mod synth;
+
+use std::io::Write;
+use std::process::ExitCode;
+
+/// Exit code for errors caused by the user's input (model, rules, cell, flags).
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+#[derive(Debug)]
+pub struct Failure {
+    pub code: u8,
+    pub message: String,
+}
+
+pub type CmdResult = Result<ExitCode, Failure>;
+
+impl Failure {
+    pub fn bad_input(message: impl Into<String>) -> Self {
+        Failure {
+            code: EXIT_BAD_INPUT,
+            message: message.into(),
+        }
+    }
+
+    /// Print the message (with its causes) to stderr and return the exit code.
+    pub fn report(self) -> ExitCode {
+        let _ = writeln!(std::io::stderr(), "error: {}", self.message);
+        ExitCode::from(self.code)
+    }
+}
+
+/// Any library error becomes a bad-input failure whose message lists its causes.
+impl<E: std::error::Error> From<E> for Failure {
+    fn from(err: E) -> Self {
+        let mut message = err.to_string();
+        let mut source = err.source();
+        while let Some(cause) = source {
+            message.push_str(&format!("\n  caused by: {cause}"));
+            source = cause.source();
+        }
+        Failure::bad_input(message)
+    }
+}
+
+/// Write `text` to stdout; a closed pipe (e.g. `| head`) is not an error.
+pub fn print_stdout(text: &str) -> CmdResult {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Ok(()) => Ok(ExitCode::SUCCESS),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(ExitCode::SUCCESS),
+        Err(e) => Err(Failure {
+            code: 1,
+            message: format!("cannot write to stdout: {e}"),
+        }),
+    }
+}

@@ -1,0 +1,1 @@
+//! ifc (being built).

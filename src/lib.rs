@@ -1,0 +1,12 @@
+//! framewright: IFC light wood-frame walls to a checked, simulated robotic assembly.
+//!
+//! Stages (each takes the previous stage's value and returns its own):
+//! `step` (ISO 10303-21 bytes) → `ifc` (units, placements, lumber pieces) →
+//! `logic` (rule language) → `cell` (robots, tools, layouts, kinematics).
+//! See `docs/ARCHITECTURE.md` for the codemap.
+
+pub mod cell;
+pub mod ifc;
+pub mod logic;
+pub mod step;
+pub mod synth;

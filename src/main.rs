@@ -1,0 +1,46 @@
+//! The `framewright` command line. Each subcommand lives in `cli/<name>.rs`;
+//! library errors are reported here with exit code 2 (bad input).
+
+mod cli;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "framewright",
+    version,
+    about = "IFC wood-frame walls to a checked, simulated robotic assembly"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Read an IFC model and list its lumber pieces.
+    Inspect(cli::inspect::InspectArgs),
+    /// Run or check a rule program (a subset of Soufflé's Datalog).
+    #[command(subcommand)]
+    Rules(cli::rules::RulesCommand),
+    /// Robot kinematics: forward and inverse.
+    #[command(subcommand)]
+    Robot(cli::robot::RobotCommand),
+    /// Write a synthetic wood-frame IFC model (the bundled examples, benchmark models).
+    Synth(cli::synth::SynthArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Inspect(args) => cli::inspect::run(args),
+        Command::Rules(cmd) => cli::rules::run(cmd),
+        Command::Robot(cmd) => cli::robot::run(cmd),
+        Command::Synth(args) => cli::synth::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(failure) => failure.report(),
+    }
+}
