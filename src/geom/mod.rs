@@ -1,0 +1,10 @@
+//! Geometry shared by the stages: oriented boxes (one per lumber piece) and
+//! box fitting from points.
+
+mod obox;
+
+pub use obox::{OrientedBox, fit_points};
+
+pub type Point3 = nalgebra::Point3<f64>;
+pub type Vector3 = nalgebra::Vector3<f64>;
+pub type Affine = nalgebra::Matrix4<f64>;
