@@ -9,5 +9,6 @@ pub mod cell;
 pub mod geom;
 pub mod ifc;
 pub mod logic;
+pub mod report;
 pub mod step;
 pub mod synth;

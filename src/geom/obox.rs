@@ -1,5 +1,7 @@
 //! Oriented boxes: a centre, three orthonormal axes and half sizes.
-//! Axes are ordered by size: `axes[0]` is the longest (the lumber's length).
+//! `axes[0]` is the lumber's length direction (the longest side unless the
+//! geometry says otherwise, e.g. a cripple stud shorter than its section);
+//! `axes[1]` and `axes[2]` are the wider and the thinner cross-section side.
 
 use super::{Affine, Point3, Vector3};
 use nalgebra::{Matrix3, SymmetricEigen};
@@ -7,9 +9,9 @@ use nalgebra::{Matrix3, SymmetricEigen};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OrientedBox {
     pub centre: Point3,
-    /// Unit axes, longest first; right-handed.
+    /// Unit axes: length, width, thickness; right-handed.
     pub axes: [Vector3; 3],
-    /// Half sizes along `axes`, non-increasing.
+    /// Half sizes along `axes`; `half[1] >= half[2]`.
     pub half: [f64; 3],
 }
 
@@ -17,9 +19,25 @@ impl OrientedBox {
     /// Builds a box from arbitrary axes and half sizes: sorts them by size
     /// (longest first) and makes the frame right-handed.
     pub fn new(centre: Point3, axes: [Vector3; 3], half: [f64; 3]) -> Self {
+        Self::with_length_axis(centre, axes, half, None)
+    }
+
+    /// Like [`OrientedBox::new`], but `axes[length]` is the length direction
+    /// when given, unless it is the thinnest side (then the piece is a slab
+    /// extruded through its thickness and the longest side is the length).
+    pub fn with_length_axis(
+        centre: Point3,
+        axes: [Vector3; 3],
+        half: [f64; 3],
+        length: Option<usize>,
+    ) -> Self {
         let mut order = [0usize, 1, 2];
         // Stable on ties so that equal sizes keep the caller's order.
         order.sort_by(|&a, &b| half[b].total_cmp(&half[a]));
+        if let Some(l) = length.filter(|&l| l < 3 && l != order[2]) {
+            let rest: Vec<usize> = order.iter().copied().filter(|&i| i != l).collect();
+            order = [l, rest[0], rest[1]];
+        }
         let mut axes = order.map(|i| axes[i].normalize());
         if axes[0].cross(&axes[1]).dot(&axes[2]) < 0.0 {
             axes[2] = -axes[2];
@@ -33,11 +51,16 @@ impl OrientedBox {
 
     /// The box of local bounds `min..max` placed by an affine map whose
     /// columns stay orthogonal; `None` when the map shears the box.
-    pub fn from_affine_bounds(map: &Affine, min: &Point3, max: &Point3) -> Option<Self> {
+    pub fn from_affine_bounds(
+        map: &Affine,
+        min: &Point3,
+        max: &Point3,
+        length: Option<usize>,
+    ) -> Option<Self> {
         let linear = map.fixed_view::<3, 3>(0, 0).into_owned();
         let edges: [Vector3; 3] = [0, 1, 2].map(|i| linear.column(i) * (max[i] - min[i]));
         let lengths = edges.map(|e| e.norm());
-        if lengths.iter().any(|&l| !(l > 0.0) || !l.is_finite()) {
+        if lengths.iter().any(|&l| !super::above(l, 0.0)) {
             return None;
         }
         for (a, b) in [(0, 1), (0, 2), (1, 2)] {
@@ -47,10 +70,11 @@ impl OrientedBox {
         }
         let centre_local = Point3::from((min.coords + max.coords) / 2.0);
         let centre = map.transform_point(&centre_local);
-        Some(OrientedBox::new(
+        Some(OrientedBox::with_length_axis(
             centre,
             edges.map(|e| e / e.norm()),
             lengths.map(|l| l / 2.0),
+            length,
         ))
     }
 
@@ -132,7 +156,7 @@ pub fn fit_points(points: &[Point3]) -> Option<OrientedBox> {
         }
     }
     let half = [0, 1, 2].map(|i| (max[i] - min[i]) / 2.0);
-    if half.iter().any(|&h| !(h > 1e-12)) {
+    if half.iter().any(|&h| !super::above(h, 1e-12)) {
         return None;
     }
     let centre = Point3::from(
@@ -265,16 +289,30 @@ mod tests {
         let mut m = Affine::identity();
         m[(0, 1)] = 0.5;
         assert!(
-            OrientedBox::from_affine_bounds(&m, &Point3::origin(), &Point3::new(1., 1., 1.))
+            OrientedBox::from_affine_bounds(&m, &Point3::origin(), &Point3::new(1., 1., 1.), None)
                 .is_none()
         );
         let ok = OrientedBox::from_affine_bounds(
             &Affine::identity(),
             &Point3::origin(),
             &Point3::new(3., 1., 2.),
+            None,
         )
         .unwrap();
         assert_eq!(ok.half, [1.5, 1.0, 0.5]);
         assert_eq!(ok.centre, Point3::new(1.5, 0.5, 1.0));
+    }
+
+    #[test]
+    fn length_axis_wins_unless_thinnest() {
+        let o = Point3::origin();
+        let axes = [Vector3::x(), Vector3::y(), Vector3::z()];
+        // A cripple: 60 mm long (z) with an 89 x 38 mm section.
+        let cripple = OrientedBox::with_length_axis(o, axes, [0.0445, 0.019, 0.030], Some(2));
+        assert_eq!(cripple.half, [0.030, 0.0445, 0.019]);
+        assert!(cripple.axes[0].cross(&Vector3::z()).norm() < 1e-12);
+        // A slab extruded through its thickness: the longest side is the length.
+        let slab = OrientedBox::with_length_axis(o, axes, [10.0, 0.25, 0.08], Some(2));
+        assert_eq!(slab.half, [10.0, 0.25, 0.08]);
     }
 }

@@ -534,22 +534,10 @@ impl<'a> Scanner<'a> {
             let i = at + p;
             match bytes[i] {
                 b';' => return Ok(i),
-                b'\'' => {
-                    // Skip the string; `''` inside it is an escaped quote.
-                    let mut j = i + 1;
-                    loop {
-                        let Some(q) = memchr::memchr(b'\'', &bytes[j..]) else {
-                            return Err(truncated());
-                        };
-                        j += q + 1;
-                        if bytes.get(j) == Some(&b'\'') {
-                            j += 1;
-                        } else {
-                            break;
-                        }
-                    }
-                    at = j;
-                }
+                b'\'' => match super::strings::string_end(&bytes[i + 1..]) {
+                    Some(end) => at = i + 1 + end + 1,
+                    None => return Err(truncated()),
+                },
                 _ => {
                     if bytes.get(i + 1) == Some(&b'*') {
                         let Some(q) = memchr::memmem::find(&bytes[i + 2..], b"*/") else {

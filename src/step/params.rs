@@ -179,18 +179,12 @@ fn number(input: &[u8]) -> Res<'_, Param<'_>> {
 /// The bytes of a string literal between its quotes (`''` stays doubled).
 fn string(input: &[u8]) -> Res<'_, &[u8]> {
     let (body, _) = char('\'').parse(input)?;
-    let mut at = 0;
-    loop {
-        match memchr::memchr(b'\'', &body[at..]) {
-            Some(p) if body.get(at + p + 1) == Some(&b'\'') => at += p + 2,
-            Some(p) => return Ok((&body[at + p + 1..], &body[..at + p])),
-            None => {
-                return Err(nom::Err::Failure(DepthError {
-                    input,
-                    too_deep: false,
-                }));
-            }
-        }
+    match super::strings::string_end(body) {
+        Some(end) => Ok((&body[end + 1..], &body[..end])),
+        None => Err(nom::Err::Failure(DepthError {
+            input,
+            too_deep: false,
+        })),
     }
 }
 

@@ -7,6 +7,31 @@
 
 use std::borrow::Cow;
 
+/// Offset of the quote that closes a string, in `body` (the bytes after the
+/// opening quote). `''` is an escaped quote; so is the byte after `\S\`,
+/// which some exporters leave undoubled when it is a quote.
+pub(crate) fn string_end(body: &[u8]) -> Option<usize> {
+    let mut at = 0;
+    loop {
+        let i = at + memchr::memchr2(b'\'', b'\\', &body[at..])?;
+        if body[i] == b'\'' {
+            if body.get(i + 1) == Some(&b'\'') {
+                at = i + 2;
+                continue;
+            }
+            return Some(i);
+        }
+        at = match body.get(i + 1..i + 3) {
+            Some(b"S\\") => i + 4,
+            _ if body.get(i + 1) == Some(&b'\\') => i + 2,
+            _ => i + 1,
+        };
+        if at > body.len() {
+            return None;
+        }
+    }
+}
+
 /// Decodes the bytes between the quotes of a STEP string.
 /// Returns the text and whether invalid bytes had to be replaced.
 pub fn decode_step_string(raw: &[u8]) -> (Cow<'_, str>, bool) {
@@ -139,6 +164,17 @@ mod tests {
     #[test]
     fn malformed_escape_is_kept() {
         assert_eq!(d(b"a\\X2\\12").0, "a\\X2\\12");
+    }
+
+    #[test]
+    fn string_ends() {
+        use super::string_end as e;
+        assert_eq!(e(b"abc',"), Some(3));
+        assert_eq!(e(b"a''b'"), Some(4));
+        assert_eq!(e(b"a\\S\\'b'"), Some(6));
+        assert_eq!(e(b"a\\\\'"), Some(3));
+        assert_eq!(e(b"open"), None);
+        assert_eq!(e(b"x\\S\\"), None);
     }
 
     #[test]
