@@ -1,6 +1,6 @@
 //! `framewright inspect MODEL.ifc [--json]`: what the reader finds in a model.
 
-use super::{CmdResult, print_stdout};
+use super::{CmdResult, print_stdout, write_stdout};
 use framewright::ifc::Model;
 use framewright::report::inspect::InspectReport;
 use framewright::step::ReadOptions;
@@ -26,7 +26,7 @@ pub fn run(args: InspectArgs) -> CmdResult {
     let model = Model::open_with(&args.model, &options)?;
     let report = InspectReport::new(&model);
     if args.json {
-        print_stdout(&report.to_json())
+        write_stdout(|out| report.write_json(&mut &mut *out))
     } else {
         print_stdout(&report.to_text())
     }

@@ -72,11 +72,11 @@ pub(crate) fn body_items(ctx: &Ctx<'_>, product: &Entity<'_>) -> R<Option<Vec<Pl
             }
             Err(other) => return Err(other),
         };
-        let identifier = ctx.text(&rep, 1).unwrap_or_default().to_ascii_uppercase();
-        let kind = ctx.text(&rep, 2).unwrap_or_default().to_ascii_uppercase();
-        if identifier == "BODY" && body.is_none() {
+        let identifier = ctx.text(&rep, 1).unwrap_or_default();
+        let kind = ctx.text(&rep, 2).unwrap_or_default();
+        if identifier.eq_ignore_ascii_case("BODY") && body.is_none() {
             body = Some(rep);
-        } else if fallback.is_none() && SOLID_TYPES.contains(&kind.as_str()) {
+        } else if fallback.is_none() && SOLID_TYPES.iter().any(|t| t.eq_ignore_ascii_case(&kind)) {
             fallback = Some(rep);
         }
     }
