@@ -1,8 +1,10 @@
 //! Geometry shared by the stages: oriented boxes (one per lumber piece) and
 //! box fitting from points.
 
+mod contact;
 mod obox;
 
+pub use contact::{Contact, ContactKind, ContactOptions, Face, contacts};
 pub use obox::{OrientedBox, fit_points};
 
 pub type Point3 = nalgebra::Point3<f64>;
