@@ -154,8 +154,10 @@ impl Parser<'_> {
     }
 }
 
+type Entities = BTreeMap<usize, (String, Vec<V>)>;
+
 /// Entities of a file: id -> (NAME, attributes). Fails on anything malformed.
-fn parse_step(text: &str) -> Result<(String, BTreeMap<usize, (String, Vec<V>)>), String> {
+fn parse_step(text: &str) -> Result<(String, Entities), String> {
     let (header, rest) = text.split_once("DATA;\n").ok_or("no DATA section")?;
     if !header.starts_with("ISO-10303-21;\nHEADER;\n") || !header.ends_with("ENDSEC;\n") {
         return Err("bad header".into());
@@ -220,8 +222,6 @@ fn parse_step(text: &str) -> Result<(String, BTreeMap<usize, (String, Vec<V>)>),
     }
     Ok((schema, entities))
 }
-
-type Entities = BTreeMap<usize, (String, Vec<V>)>;
 
 fn num(v: &V) -> f64 {
     match v {
