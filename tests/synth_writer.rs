@@ -321,8 +321,14 @@ fn centre_lines(e: &Entities) -> BTreeMap<String, (Vector3<f64>, Vector3<f64>)> 
                 let (s1, s3) = (num(&oa[3]), num(&oa[6]));
                 assert_eq!(s1, 1.0);
                 // The mapped source is a section extruded 1 unit along z.
+                // DESIGN §3: a one-piece product's piece id is its GlobalId.
+                let id = if items.len() == 1 {
+                    gid.clone()
+                } else {
+                    format!("{gid}/{k}")
+                };
                 out.insert(
-                    format!("{gid}/{k}"),
+                    id,
                     (apply(&place, origin), apply(&place, origin + axis3 * s3)),
                 );
             }

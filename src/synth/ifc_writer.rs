@@ -776,8 +776,14 @@ fn write_mapped_wall(
                 .add(kind.entity, product_line(ctx.opts.schema, kind, &head)),
         );
         for (item, &k) in indices.iter().enumerate() {
+            // DESIGN §3: a one-piece product's piece id is its GlobalId.
+            let piece_id = if indices.len() == 1 {
+                gid.clone()
+            } else {
+                format!("{gid}/{item}")
+            };
             rows[k] = Some(truth_member(
-                format!("{gid}/{item}"),
+                piece_id,
                 name.clone(),
                 kind,
                 ctx.opts.schema,
