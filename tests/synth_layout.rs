@@ -8,6 +8,7 @@ use framewright::synth::wall::{
     HeaderStyle, OpeningKind, OpeningSpec, StudLayout, WallSpec, frame_wall,
 };
 use framewright::synth::{SynthError, WriteOptions, write_ifc};
+use std::collections::BTreeMap;
 use std::path::Path;
 
 const EPS: f64 = 1e-9;
@@ -191,6 +192,103 @@ fn same_as_shared(layout: &Layout, shared_name: &str) {
                 "{shared_name} frame row {r}"
             );
         }
+    }
+    same_targets_as_shared(&ours, &theirs, shared_name);
+}
+
+/// Member keys independent of GlobalIds: wall, role and wall-local box.
+fn box_keys(doc: &serde_json::Value) -> BTreeMap<String, String> {
+    let r = |v: &serde_json::Value| format!("{:.6}", v.as_f64().unwrap());
+    doc["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| {
+            let b = &m["wall_local_box"];
+            let key = format!(
+                "{} {} u {} {} v {} {} w {} {}",
+                m["wall_id"],
+                m["role"],
+                r(&b["u"][0]),
+                r(&b["u"][1]),
+                r(&b["v"][0]),
+                r(&b["v"][1]),
+                r(&b["w"][0]),
+                r(&b["w"][1])
+            );
+            (m["global_id"].as_str().unwrap().to_string(), key)
+        })
+        .collect()
+}
+
+/// Precedence, nailing targets and assembly-order roles agree with the shared truth.
+fn same_targets_as_shared(ours: &serde_json::Value, theirs: &serde_json::Value, shared_name: &str) {
+    let r = |v: &serde_json::Value| format!("{:.6}", v.as_f64().unwrap());
+    let (ka, kb) = (box_keys(ours), box_keys(theirs));
+    let id =
+        |keys: &BTreeMap<String, String>, v: &serde_json::Value| keys[v.as_str().unwrap()].clone();
+    for (x, y) in ours["walls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(theirs["walls"].as_array().unwrap())
+    {
+        let prec = |w: &serde_json::Value, keys: &BTreeMap<String, String>| {
+            let mut v: Vec<String> = w["precedence_constraints"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| {
+                    format!(
+                        "{} < {} {}",
+                        id(keys, &p["before"]),
+                        id(keys, &p["after"]),
+                        p["reason"]
+                    )
+                })
+                .collect();
+            v.sort();
+            v
+        };
+        assert_eq!(
+            prec(x, &ka),
+            prec(y, &kb),
+            "{shared_name} wall {}: precedence",
+            x["wall_id"]
+        );
+        for field in ["nailing_targets", "secondary_nailing_targets"] {
+            let nails = |w: &serde_json::Value, keys: &BTreeMap<String, String>| {
+                let mut v: Vec<String> = w[field]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|n| {
+                        format!(
+                            "{} | {} | {} {} {} {} | {} {} {} | {}",
+                            id(keys, &n["plate"]),
+                            id(keys, &n["member"]),
+                            n["kind"],
+                            r(&n["u"]),
+                            r(&n["v"]),
+                            r(&n["w"]),
+                            r(&n["world"][0]),
+                            r(&n["world"][1]),
+                            r(&n["world"][2]),
+                            n["direction_world"]
+                        )
+                    })
+                    .collect();
+                v.sort();
+                v
+            };
+            let (a, b) = (nails(x, &ka), nails(y, &kb));
+            assert!(!b.is_empty() || field == "secondary_nailing_targets");
+            assert_eq!(a, b, "{shared_name} wall {}: {field}", x["wall_id"]);
+        }
+        assert_eq!(
+            x["assembly_order_roles"], y["assembly_order_roles"],
+            "{shared_name}: assembly order roles"
+        );
     }
 }
 

@@ -582,3 +582,54 @@ fn strings_and_global_ids_are_encoded_per_the_standards() {
     assert_ne!(guid::global_id(1, "a"), guid::global_id(1, "b"));
     assert_ne!(guid::global_id(1, "a"), guid::global_id(2, "a"));
 }
+
+#[test]
+fn assembly_order_respects_every_precedence_and_nails_sit_on_plate_faces() {
+    let layout = grid(&models::default_building_spec(), 1, 1, 0.0, "one").unwrap();
+    let t = write_ifc(&layout, &WriteOptions::default()).unwrap().truth;
+    let members: BTreeMap<_, _> = t.members.iter().map(|m| (m.global_id.clone(), m)).collect();
+    let (mut rests, mut ends, mut sill_nails) = (0, 0, 0);
+    for w in &t.walls {
+        let pos: BTreeMap<_, _> = w
+            .assembly_order
+            .iter()
+            .enumerate()
+            .map(|(k, id)| (id.clone(), k))
+            .collect();
+        for p in &w.precedence_constraints {
+            assert!(
+                pos[&p.before] < pos[&p.after],
+                "{} must precede {}",
+                p.before,
+                p.after
+            );
+            match p.reason {
+                "rests_on" => rests += 1,
+                _ => ends += 1,
+            }
+        }
+        for n in w.nailing_targets.iter().chain(&w.secondary_nailing_targets) {
+            let (plate, member) = (members[&n.plate], members[&n.member]);
+            let b = &plate.wall_local_box;
+            let face = if n.kind == "bottom_plate_to_stud" {
+                b.v[0]
+            } else {
+                b.v[1]
+            };
+            assert!((n.v - face).abs() < 1e-9, "nail on the plate's outer face");
+            let u = &member.wall_local_box.u;
+            assert!(
+                (n.u - 0.5 * (u[0] + u[1])).abs() < 1e-9,
+                "nail at the member's centre"
+            );
+            assert!(n.w > b.w[0] && n.w < b.w[1]);
+            assert_eq!(member.orientation, "vertical");
+        }
+        // Every standing member gets 2 nails at each end that meets a plate.
+        let ends_on_plates: usize = w.nailing_targets.len();
+        assert_eq!(ends_on_plates % 2, 0);
+        sill_nails += w.secondary_nailing_targets.len();
+    }
+    assert!(rests > 0 && ends > 0);
+    assert!(sill_nails > 0, "the default building has windows");
+}

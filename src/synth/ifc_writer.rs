@@ -8,8 +8,10 @@ use crate::synth::SynthError;
 use crate::synth::guid;
 use crate::synth::layout::{BuildingLayout, Layout, Piece, Vec3, WallLayout};
 use crate::synth::step_text::{Real, RealList, Ref, RefList, StepWriter, string};
+use crate::synth::targets::{self, Nail};
 use crate::synth::truth::{
-    self, BoxInfo, Counts, Truth, TruthMember, TruthOpening, TruthWall, q, q3,
+    self, BoxInfo, Counts, Truth, TruthMember, TruthNail, TruthOpening, TruthPrecedence, TruthWall,
+    q, q3,
 };
 use crate::synth::units::LengthUnit;
 use std::collections::BTreeMap;
@@ -856,6 +858,19 @@ fn truth_wall(
         *role_counts.entry(p.role.as_str().to_string()).or_insert(0) += 1;
     }
     let m = wall.frame.matrix();
+    let ids: Vec<String> = members.iter().map(|m| m.global_id.clone()).collect();
+    let nail = |n: &Nail| TruthNail {
+        pair: [ids[n.plate].clone(), ids[n.member].clone()],
+        plate: ids[n.plate].clone(),
+        member: ids[n.member].clone(),
+        kind: n.kind,
+        u: q(n.u),
+        v: q(n.v),
+        w: q(n.w),
+        world: q3(&wall.frame.to_world(n.u, n.v, n.w)),
+        direction_world: q3(&(wall.frame.v * n.v_direction)),
+    };
+    let (primary, secondary) = targets::nailing_targets(wall);
     TruthWall {
         wall_id: wall.id.clone(),
         wall_global_id,
@@ -871,7 +886,19 @@ fn truth_wall(
         height: q(wall.height),
         thickness: q(wall.thickness),
         frame_matrix: m.map(|row| row.map(q)),
-        member_global_ids: members.iter().map(|m| m.global_id.clone()).collect(),
+        member_global_ids: ids.clone(),
+        assembly_order: ids.clone(),
+        assembly_order_roles: wall.pieces.iter().map(|p| p.role.as_str()).collect(),
+        precedence_constraints: targets::precedence(wall)
+            .iter()
+            .map(|p| TruthPrecedence {
+                before: ids[p.before].clone(),
+                after: ids[p.after].clone(),
+                reason: p.reason.as_str(),
+            })
+            .collect(),
+        nailing_targets: primary.iter().map(nail).collect(),
+        secondary_nailing_targets: secondary.iter().map(nail).collect(),
         openings: wall
             .openings
             .iter()

@@ -12,6 +12,7 @@ pub mod ifc_writer;
 pub mod layout;
 pub mod models;
 pub mod step_text;
+pub mod targets;
 pub mod truth;
 pub mod units;
 pub mod wall;

@@ -94,6 +94,26 @@ pub struct TruthOpening {
 }
 
 #[derive(Debug, Clone, Serialize)]
+pub struct TruthPrecedence {
+    pub before: String,
+    pub after: String,
+    pub reason: &'static str,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct TruthNail {
+    pub pair: [String; 2],
+    pub plate: String,
+    pub member: String,
+    pub kind: &'static str,
+    pub u: f64,
+    pub v: f64,
+    pub w: f64,
+    pub world: [f64; 3],
+    pub direction_world: [f64; 3],
+}
+
+#[derive(Debug, Clone, Serialize)]
 pub struct TruthWall {
     pub wall_id: String,
     pub wall_global_id: Option<String>,
@@ -106,6 +126,13 @@ pub struct TruthWall {
     pub thickness: f64,
     pub frame_matrix: [[f64; 4]; 4],
     pub member_global_ids: Vec<String>,
+    /// One valid order (the layout's piece order).
+    pub assembly_order: Vec<String>,
+    pub assembly_order_roles: Vec<&'static str>,
+    pub precedence_constraints: Vec<TruthPrecedence>,
+    pub nailing_targets: Vec<TruthNail>,
+    /// Through a sill into the cripple studs below it.
+    pub secondary_nailing_targets: Vec<TruthNail>,
     pub openings: Vec<TruthOpening>,
     pub role_counts: BTreeMap<String, usize>,
 }
