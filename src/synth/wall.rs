@@ -1,0 +1,483 @@
+//! A parametric wall: plates, studs on centre, and openings framed the usual way
+//! (king and jack studs, header, rough sill, cripples above and below).
+use crate::synth::SynthError;
+use crate::synth::layout::{OpeningRecord, Piece, Role, WallBox, WallFrame, WallLayout};
+use crate::synth::units::{INCH, Lumber, feet, inches};
+
+/// Where the common studs go.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StudLayout {
+    /// Only the two end studs (the study's small test frames).
+    EndsOnly,
+    /// End studs plus studs whose centres sit at multiples of this spacing (metres) from the wall start.
+    OnCentre(f64),
+}
+
+/// How headers are made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HeaderStyle {
+    /// Plies of 2x lumber on edge, flush with both faces, 1/2 in spacers between.
+    BuiltUp,
+    /// One solid piece as thick as the wall (e.g. a 4x10 in a 2x4 wall).
+    Solid,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OpeningKind {
+    Door,
+    /// Height of the rough opening's bottom above the floor (metres).
+    Window {
+        sill: f64,
+    },
+}
+
+impl OpeningKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            OpeningKind::Door => "door",
+            OpeningKind::Window { .. } => "window",
+        }
+    }
+}
+
+/// A rough opening: left edge `u` from the wall start, clear width and height (metres).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OpeningSpec {
+    pub kind: OpeningKind,
+    pub u: f64,
+    pub width: f64,
+    pub height: f64,
+}
+
+/// Everything that defines one wall frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WallSpec {
+    pub id: String,
+    pub name: String,
+    pub length: f64,
+    /// Overall height, bottom of the bottom plate to top of the top (or cap) plate.
+    pub height: f64,
+    pub lumber: Lumber,
+    pub studs: StudLayout,
+    pub double_top_plate: bool,
+    pub header_style: HeaderStyle,
+    pub openings: Vec<OpeningSpec>,
+}
+
+// Limits that keep the generator inside what wall framing means; outside them the
+// input is a typo or a unit mix-up, so it is refused rather than drawn.
+const MIN_LENGTH: f64 = 0.3;
+const MAX_LENGTH: f64 = 30.0;
+const MIN_STUD: f64 = 0.3;
+const MAX_HEIGHT: f64 = 6.0;
+const MIN_SPACING: f64 = 8.0 * INCH;
+const MAX_SPACING: f64 = 48.0 * INCH;
+const SPACER: f64 = 0.5 * INCH;
+/// Gaps above a header smaller than this get no cripple (too short to nail).
+const MIN_CRIPPLE: f64 = 1.0 * INCH;
+
+/// Header lumber by clear span: deep enough for light residential loads.
+fn header_lumber(span: f64) -> Option<Lumber> {
+    if span <= feet(6.0) + 1e-9 {
+        Some(Lumber::L2X10)
+    } else if span <= feet(10.0) + 1e-9 {
+        Some(Lumber::L2X12)
+    } else {
+        None
+    }
+}
+
+fn wall_err(spec: &WallSpec, what: String, hint: &str) -> SynthError {
+    SynthError::Wall {
+        wall: spec.id.clone(),
+        what,
+        hint: hint.to_string(),
+    }
+}
+
+fn check_range(
+    spec: &WallSpec,
+    name: &str,
+    value: f64,
+    lo: f64,
+    hi: f64,
+) -> Result<(), SynthError> {
+    if !value.is_finite() || value < lo || value > hi {
+        return Err(wall_err(
+            spec,
+            format!("{name} {value} m is outside {lo:.3}..{hi:.3} m"),
+            "lengths are in metres unless given with a unit (ft, in, mm)",
+        ));
+    }
+    Ok(())
+}
+
+/// One opening after validation, with its framing extents.
+struct PlacedOpening {
+    index: usize,
+    spec: OpeningSpec,
+    u0: f64,
+    u1: f64,
+    /// Bottom of the rough opening (0 for doors).
+    v0: f64,
+    /// Top of the rough opening = bottom of the header.
+    v1: f64,
+    header: Lumber,
+}
+
+impl PlacedOpening {
+    /// Extent from the outer face of one king stud to the other.
+    fn zone(&self, t: f64) -> [f64; 2] {
+        [self.u0 - 2.0 * t, self.u1 + 2.0 * t]
+    }
+}
+
+/// Frame the wall in `frame`. Pieces come out in one valid assembly order:
+/// bottom plates, members standing on them by u, sills and headers, cripples
+/// above headers, top plate, cap plate.
+pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, SynthError> {
+    let t = spec.lumber.thickness;
+    let depth = spec.lumber.width; // wall thickness
+    let nominal = spec.lumber.nominal;
+    check_range(
+        spec,
+        "length",
+        spec.length,
+        MIN_LENGTH.max(3.0 * t),
+        MAX_LENGTH,
+    )?;
+    let plates = if spec.double_top_plate { 3.0 } else { 2.0 };
+    check_range(
+        spec,
+        "height",
+        spec.height,
+        MIN_STUD + plates * t,
+        MAX_HEIGHT,
+    )?;
+    if let StudLayout::OnCentre(s) = spec.studs {
+        check_range(spec, "stud spacing", s, MIN_SPACING, MAX_SPACING)?;
+    }
+    let len = spec.length;
+    let stud_top = spec.height - (plates - 1.0) * t;
+    let openings = place_openings(spec, stud_top)?;
+
+    let full_w = [0.0, depth];
+    let mut bottoms = Vec::new();
+    let mut standing = Vec::new();
+    let mut spanning = Vec::new();
+    let mut above = Vec::new();
+    let mut records = Vec::new();
+    let piece =
+        |role, detail: &str, nominal: &str, b| Piece::from_box(&frame, role, detail, nominal, b);
+
+    // Bottom plate, cut at every door.
+    let mut cuts: Vec<[f64; 2]> = openings
+        .iter()
+        .filter(|o| matches!(o.spec.kind, OpeningKind::Door))
+        .map(|o| [o.u0, o.u1])
+        .collect();
+    cuts.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let mut from = 0.0;
+    let detail = if cuts.is_empty() { "" } else { "segment" };
+    for cut in cuts.iter().chain(std::iter::once(&[len, len])) {
+        if cut[0] - from > 1e-9 {
+            bottoms.push(piece(
+                Role::BottomPlate,
+                detail,
+                nominal,
+                WallBox {
+                    u: [from, cut[0]],
+                    v: [0.0, t],
+                    w: full_w,
+                },
+            ));
+        }
+        from = cut[1];
+    }
+
+    let stud_box = |u0: f64, v0: f64, v1: f64| WallBox {
+        u: [u0, u0 + t],
+        v: [v0, v1],
+        w: full_w,
+    };
+    // End studs and studs on centre, except where an opening's framing goes.
+    let mut centres = vec![0.5 * t, len - 0.5 * t];
+    let mut grid = Vec::new();
+    if let StudLayout::OnCentre(s) = spec.studs {
+        let mut k = 1.0;
+        while k * s + 0.5 * t <= len - t + 1e-9 {
+            grid.push(k * s);
+            k += 1.0;
+        }
+    }
+    for &c in &grid {
+        let clear = openings.iter().all(|o| {
+            let z = o.zone(t);
+            c + 0.5 * t <= z[0] + 1e-9 || c - 0.5 * t >= z[1] - 1e-9
+        });
+        if clear {
+            centres.push(c);
+        }
+    }
+    for &c in &centres {
+        standing.push(piece(
+            Role::Stud,
+            "",
+            nominal,
+            stud_box(c - 0.5 * t, t, stud_top),
+        ));
+    }
+
+    for o in &openings {
+        // King studs full height, jacks under the header.
+        standing.push(piece(
+            Role::KingStud,
+            "",
+            nominal,
+            stud_box(o.u0 - 2.0 * t, t, stud_top),
+        ));
+        standing.push(piece(
+            Role::KingStud,
+            "",
+            nominal,
+            stud_box(o.u1 + t, t, stud_top),
+        ));
+        standing.push(piece(
+            Role::JackStud,
+            "",
+            nominal,
+            stud_box(o.u0 - t, t, o.v1),
+        ));
+        standing.push(piece(Role::JackStud, "", nominal, stud_box(o.u1, t, o.v1)));
+        // Cripples on the stud grid inside the rough opening.
+        let inside: Vec<f64> = grid
+            .iter()
+            .copied()
+            .filter(|&c| c - 0.5 * t >= o.u0 - 1e-9 && c + 0.5 * t <= o.u1 + 1e-9)
+            .collect();
+        if let OpeningKind::Window { sill } = o.spec.kind {
+            spanning.push(piece(
+                Role::Sill,
+                "",
+                nominal,
+                WallBox {
+                    u: [o.u0, o.u1],
+                    v: [sill - t, sill],
+                    w: full_w,
+                },
+            ));
+            for &c in &inside {
+                standing.push(piece(
+                    Role::CrippleStud,
+                    "below_sill",
+                    nominal,
+                    stud_box(c - 0.5 * t, t, sill - t),
+                ));
+            }
+        }
+        let h = o.header;
+        let hu = [o.u0 - t, o.u1 + t];
+        let hv = [o.v1, o.v1 + h.width];
+        let label = match spec.header_style {
+            HeaderStyle::Solid => {
+                let name = format!("{}x{}", (depth / INCH).ceil() as u32, &h.nominal[2..]);
+                spanning.push(piece(
+                    Role::Header,
+                    "",
+                    &name,
+                    WallBox {
+                        u: hu,
+                        v: hv,
+                        w: full_w,
+                    },
+                ));
+                name
+            }
+            HeaderStyle::BuiltUp => {
+                let plies = ((depth + SPACER) / (h.thickness + SPACER) + 1e-9)
+                    .floor()
+                    .max(1.0) as usize;
+                for k in 0..plies {
+                    let w0 = if plies == 1 {
+                        0.0
+                    } else {
+                        (depth - h.thickness) * k as f64 / (plies - 1) as f64
+                    };
+                    let detail = match k {
+                        0 => "ply 1 (outer face)".to_string(),
+                        k if k + 1 == plies => format!("ply {} (inner face)", k + 1),
+                        k => format!("ply {}", k + 1),
+                    };
+                    spanning.push(piece(
+                        Role::Header,
+                        &detail,
+                        h.nominal,
+                        WallBox {
+                            u: hu,
+                            v: hv,
+                            w: [w0, w0 + h.thickness],
+                        },
+                    ));
+                }
+                format!("{}x{}", h.nominal, plies)
+            }
+        };
+        if stud_top - hv[1] >= MIN_CRIPPLE {
+            for &c in &inside {
+                above.push(piece(
+                    Role::CrippleStud,
+                    "above_header",
+                    nominal,
+                    stud_box(c - 0.5 * t, hv[1], stud_top),
+                ));
+            }
+        }
+        records.push(OpeningRecord {
+            kind: o.spec.kind.name(),
+            rough_opening_u: [o.u0, o.u1],
+            rough_opening_v: [o.v0, o.v1],
+            header: label,
+        });
+    }
+
+    let by_u = |a: &Piece, b: &Piece| {
+        a.wall_box.u[0]
+            .total_cmp(&b.wall_box.u[0])
+            .then(a.wall_box.w[0].total_cmp(&b.wall_box.w[0]))
+    };
+    standing.sort_by(by_u);
+    spanning.sort_by(|a, b| a.role.cmp(&b.role).then(by_u(a, b)));
+    above.sort_by(by_u);
+    let mut pieces = bottoms;
+    pieces.extend(standing);
+    pieces.extend(spanning);
+    pieces.extend(above);
+    pieces.push(piece(
+        Role::TopPlate,
+        "",
+        nominal,
+        WallBox {
+            u: [0.0, len],
+            v: [stud_top, stud_top + t],
+            w: full_w,
+        },
+    ));
+    if spec.double_top_plate {
+        pieces.push(piece(
+            Role::CapPlate,
+            "",
+            nominal,
+            WallBox {
+                u: [0.0, len],
+                v: [stud_top + t, stud_top + 2.0 * t],
+                w: full_w,
+            },
+        ));
+    }
+    Ok(WallLayout {
+        id: spec.id.clone(),
+        name: spec.name.clone(),
+        frame,
+        length: len,
+        height: spec.height,
+        thickness: depth,
+        pieces,
+        openings: records,
+    })
+}
+
+/// Validate openings against the wall and each other; sorted by u.
+fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, SynthError> {
+    let t = spec.lumber.thickness;
+    let mut placed = Vec::new();
+    for (index, o) in spec.openings.iter().enumerate() {
+        let err = |what: String, hint: &str| SynthError::Opening {
+            wall: spec.id.clone(),
+            index,
+            kind: o.kind.name(),
+            what,
+            hint: hint.to_string(),
+        };
+        for (name, v) in [("u", o.u), ("width", o.width), ("height", o.height)] {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(err(
+                    format!("{name} must be a positive length, got {v}"),
+                    "give U,W,H in metres or with a unit",
+                ));
+            }
+        }
+        let (u0, u1) = (o.u, o.u + o.width);
+        if u0 - 2.0 * t < t - 1e-9 || u1 + 2.0 * t > spec.length - t + 1e-9 {
+            return Err(err(
+                format!(
+                    "rough opening u {u0:.4}..{u1:.4} m with its jack and king studs does not fit between the end studs of a {:.4} m wall",
+                    spec.length
+                ),
+                "the opening needs 3 stud thicknesses of wall on each side; move or narrow it",
+            ));
+        }
+        let header = header_lumber(o.width).ok_or_else(|| {
+            err(
+                format!("clear span {:.3} m is over 10 ft", o.width),
+                "split the opening; longer spans need an engineered header",
+            )
+        })?;
+        let (v0, v1) = match o.kind {
+            OpeningKind::Door => (0.0, o.height),
+            OpeningKind::Window { sill } => {
+                if !sill.is_finite() || sill - t < t + 0.05 {
+                    return Err(err(
+                        format!(
+                            "sill height {sill} m leaves no room for the rough sill and cripples below it"
+                        ),
+                        "raise the window (sill height is measured from the floor to the rough opening)",
+                    ));
+                }
+                (sill, sill + o.height)
+            }
+        };
+        if v1 <= t + 1e-9 {
+            return Err(err(
+                format!("opening top {v1:.4} m is not above the bottom plate"),
+                "make the opening taller",
+            ));
+        }
+        if v1 + header.width > stud_top + 1e-9 {
+            return Err(err(
+                format!(
+                    "opening top {v1:.4} m plus a {} header ({:.4} m) is above the top plate at {stud_top:.4} m",
+                    header.nominal, header.width
+                ),
+                "lower or shorten the opening, or make the wall taller",
+            ));
+        }
+        placed.push(PlacedOpening {
+            index,
+            spec: *o,
+            u0,
+            u1,
+            v0,
+            v1,
+            header,
+        });
+    }
+    placed.sort_by(|a, b| a.u0.total_cmp(&b.u0));
+    for pair in placed.windows(2) {
+        if pair[0].zone(t)[1] > pair[1].zone(t)[0] + 1e-9 {
+            let o = &pair[1];
+            return Err(SynthError::Opening {
+                wall: spec.id.clone(),
+                index: o.index,
+                kind: o.spec.kind.name(),
+                what: format!("its framing overlaps opening {}", pair[0].index),
+                hint: "keep 4 stud thicknesses between rough openings".into(),
+            });
+        }
+    }
+    Ok(placed)
+}
+
+/// The study's precut stud length (92-5/8 in) for 8 ft walls with a double top plate.
+pub fn precut_stud() -> f64 {
+    inches(92.625)
+}
