@@ -26,16 +26,33 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
 }
 
-#[test]
-fn every_truth_member_within_half_a_millimetre() {
-    let Some(dir) = testcases() else { return };
-    let mut truths: Vec<PathBuf> = std::fs::read_dir(&dir)
+fn truth_files(dir: &Path) -> Vec<PathBuf> {
+    let mut truths: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.to_string_lossy().ends_with(".truth.json"))
         .collect();
     truths.sort();
-    assert!(!truths.is_empty());
+    assert!(!truths.is_empty(), "no truth files in {}", dir.display());
+    truths
+}
+
+#[test]
+fn shared_truth_models_within_half_a_millimetre() {
+    let Some(dir) = testcases() else { return };
+    check_all(truth_files(&dir));
+}
+
+/// The project's own models (bundled examples and fixtures written by `synth`).
+#[test]
+fn own_truth_models_within_half_a_millimetre() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = truth_files(&root.join("examples/models"));
+    files.extend(truth_files(&root.join("tests/fixtures")));
+    check_all(files);
+}
+
+fn check_all(truths: Vec<PathBuf>) {
     for truth_path in truths {
         let ifc = PathBuf::from(truth_path.to_string_lossy().replace(".truth.json", ".ifc"));
         let truth: Value =
