@@ -7,6 +7,7 @@
 //! - `compiled`: ascent programs generated from `rules/*.dl` and `tests/logic/*.dl`.
 //! - `functors`: the Rust functors `@name(...)`; `ops`: typed operations both engines share.
 
+pub mod compiled;
 pub mod error;
 pub mod front;
 pub mod functors;

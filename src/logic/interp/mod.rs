@@ -642,13 +642,10 @@ impl<'a> Exec<'a> {
                         AggOp::Min | AggOp::Max => {
                             let better = match &acc {
                                 None => true,
+                                // Total order (floats too), so the result does not depend on visiting order.
                                 Some(a) => {
-                                    let op = if agg.op == AggOp::Min {
-                                        super::front::ast::CmpOp::Lt
-                                    } else {
-                                        super::front::ast::CmpOp::Gt
-                                    };
-                                    compare(op, &v, a)
+                                    (agg.op == AggOp::Min && v < *a)
+                                        || (agg.op == AggOp::Max && v > *a)
                                 }
                             };
                             if better {
