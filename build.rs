@@ -1,5 +1,5 @@
-//! Compiles the rule programs `rules/*.dl` (built-in rule base) and
-//! `tests/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
+//! Compiles the rule programs `rules/*.dl` (built-in rule base),
+//! `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
 //! using the same parser and checker as the interpreter.
 
 use std::fmt::Write as _;
@@ -72,7 +72,7 @@ fn main() {
     println!("cargo:rerun-if-changed=src/logic/functor_defs.rs");
     let mut out = String::new();
     let mut table = Vec::new();
-    for dir in ["rules", "tests/logic"] {
+    for dir in ["rules", "tests/logic", "benches/logic"] {
         println!("cargo:rerun-if-changed={dir}");
         let abs = root.join(dir);
         // Included fragments live in subdirectories; watch them too.

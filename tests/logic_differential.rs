@@ -42,6 +42,7 @@ fn inputs(program: &Arc<Program>, facts: &Path) -> Relations {
 fn interpreter_and_compiled_agree_on_every_program() {
     let mut files = dl_files("rules");
     files.extend(dl_files("tests/logic"));
+    files.extend(dl_files("benches/logic"));
     assert!(files.len() >= 5);
     for rel in files {
         let path = root().join(&rel);

@@ -76,7 +76,7 @@ pub fn generate(prog: &Program, module: &str) -> Result<String, String> {
         ident(&module.replace(['/', '.', '-'], "_"))
     );
     s.push_str("use crate::logic::compiled::rt;\nuse crate::logic::value::{Column, Value, F64, Sym, Vec3, Iso, OBox};\nuse std::collections::BTreeMap;\n");
-    s.push_str("ascent::ascent! {\nstruct Prog;\n");
+    s.push_str("ascent::ascent! {\npub struct Prog;\n");
     for r in &prog.relations {
         let cols: Vec<&str> = r.attrs.iter().map(|a| rust_ty(a.ty)).collect();
         let _ = writeln!(s, "relation {}({});", rel_name(&r.name), cols.join(", "));
