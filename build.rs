@@ -1,0 +1,109 @@
+//! Compiles the rule programs `rules/*.dl` (built-in rule base),
+//! `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
+//! using the same parser and checker as the interpreter.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+#[allow(dead_code, unused_imports)]
+#[path = "src/logic/front/mod.rs"]
+mod front;
+
+use front::ast::BaseTy;
+
+/// The functor signatures, read from the same table the crate uses.
+trait Ty {
+    const TY: BaseTy;
+}
+#[allow(dead_code)]
+struct F64;
+#[allow(dead_code)]
+struct Sym;
+struct Vec3;
+struct Iso;
+struct OBox;
+impl Ty for i64 {
+    const TY: BaseTy = BaseTy::Number;
+}
+impl Ty for u64 {
+    const TY: BaseTy = BaseTy::Unsigned;
+}
+impl Ty for F64 {
+    const TY: BaseTy = BaseTy::Float;
+}
+impl Ty for Sym {
+    const TY: BaseTy = BaseTy::Symbol;
+}
+impl Ty for Vec3 {
+    const TY: BaseTy = BaseTy::Vec3;
+}
+impl Ty for Iso {
+    const TY: BaseTy = BaseTy::Iso;
+}
+impl Ty for OBox {
+    const TY: BaseTy = BaseTy::Box;
+}
+
+macro_rules! functor_table {
+    ($( $(#[$doc:meta])* fn $name:ident ( $($arg:ident : $ty:ident),* ) -> $ret:ident $body:block )*) => {
+        const SIGS: &[front::FunctorSig] = &[
+            $( front::FunctorSig { name: stringify!($name), params: &[$(<$ty as Ty>::TY),*], ret: <$ret as Ty>::TY }, )*
+        ];
+    };
+}
+include!("src/logic/functor_defs.rs");
+
+fn dl_files(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "dl"))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+fn main() {
+    let root =
+        PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    println!("cargo:rerun-if-changed=src/logic/front");
+    println!("cargo:rerun-if-changed=src/logic/functor_defs.rs");
+    let mut out = String::new();
+    let mut table = Vec::new();
+    for dir in ["rules", "tests/logic", "benches/logic"] {
+        println!("cargo:rerun-if-changed={dir}");
+        let abs = root.join(dir);
+        // Included fragments live in subdirectories; watch them too.
+        if let Ok(rd) = std::fs::read_dir(&abs) {
+            for e in rd.flatten() {
+                println!("cargo:rerun-if-changed={}", e.path().display());
+            }
+        }
+        for file in dl_files(&abs) {
+            let rel = format!("{dir}/{}", file.file_name().unwrap().to_string_lossy());
+            let program = match front::load_files(std::slice::from_ref(&file), SIGS) {
+                Ok(p) => p,
+                Err(e) => panic!("rule program {rel} does not check:\n{e}"),
+            };
+            let module = rel.trim_end_matches(".dl").replace(['/', '.', '-'], "_");
+            match front::codegen::generate(&program, &module) {
+                Ok(code) => out.push_str(&code),
+                Err(e) => panic!("rule program {rel} cannot be compiled to ascent: {e}"),
+            }
+            table.push((rel, module));
+        }
+    }
+    let _ = writeln!(
+        out,
+        "/// Every compiled program: (path, entry point).\npub static PROGRAMS: &[(&str, RunFn)] = &["
+    );
+    for (rel, module) in &table {
+        let _ = writeln!(out, "    ({rel:?}, {module}::run),");
+    }
+    out.push_str("];\n");
+    let dest = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
+        .join("logic_compiled.rs");
+    std::fs::write(&dest, out).expect("write generated rules");
+}

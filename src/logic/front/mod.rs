@@ -1,0 +1,34 @@
+//! Front end of the rule language: lexer, parser, checker and the ascent
+//! code generator. Self-contained (std only) so `build.rs` can include it
+//! with `#[path = "src/logic/front/mod.rs"] mod front;`.
+
+// Nested `if`s keep the checker readable next to its error messages.
+#![allow(clippy::collapsible_if)]
+
+pub mod ast;
+pub mod check;
+pub mod codegen;
+pub mod diag;
+pub mod lex;
+pub mod parse;
+
+pub use check::{FunctorSig, Program, Stratum};
+pub use diag::{Diagnostic, Diagnostics, Source};
+
+use std::path::{Path, PathBuf};
+
+/// Parse and check the given files (and what they `.include`) as one program.
+pub fn load_files(paths: &[PathBuf], functors: &[FunctorSig]) -> Result<Program, Diagnostics> {
+    let mut loader = check::Loader::new(functors);
+    for p in paths {
+        loader.load_file(p, None)?;
+    }
+    loader.finish()
+}
+
+/// Parse and check program text; `.include` paths resolve against the current directory.
+pub fn load_str(name: &str, text: &str, functors: &[FunctorSig]) -> Result<Program, Diagnostics> {
+    let mut loader = check::Loader::new(functors);
+    loader.load_text(name, text, Path::new("."))?;
+    loader.finish()
+}

@@ -1,0 +1,683 @@
+//! The interpreter: semi-naive bottom-up evaluation, stratum by stratum, over
+//! hash-indexed relations; optionally records provenance for explanations.
+
+pub mod compile;
+mod eval;
+pub mod store;
+
+use self::compile::{CAgg, CRule, CStep, Range};
+use self::store::{Relation, hash_values};
+use super::error::LogicError;
+use super::front::Program;
+use super::front::ast::{AggOp, BaseTy};
+use super::value::Value;
+use serde::Serialize;
+use std::sync::Arc;
+
+pub use self::eval::compare;
+
+/// Evaluate a compiled expression (used by explanations).
+pub(crate) fn eval_pub(e: &compile::CExpr, env: &[Value]) -> Result<Value, String> {
+    eval::eval(e, env)
+}
+
+/// Where an input tuple came from, so explanations can point at it.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub enum Origin {
+    /// A line of a facts file.
+    File { file: String, line: u32 },
+    /// An IFC entity `#id`.
+    Entity(u64),
+    /// A simulation event (its id or description).
+    Event(String),
+    /// Inserted by Rust code without a source.
+    Rust,
+}
+
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Origin::File { file, line } => write!(f, "{file}:{line}"),
+            Origin::Entity(id) => write!(f, "IFC #{id}"),
+            Origin::Event(e) => write!(f, "event {e}"),
+            Origin::Rust => f.write_str("inserted by the program"),
+        }
+    }
+}
+
+/// How a stored tuple was obtained.
+#[derive(Clone, Debug)]
+pub enum Prov {
+    Input(Origin),
+    /// Rule index and the (relation, tuple id) matched by each positive body atom, in plan order.
+    Derived {
+        rule: u32,
+        body: Box<[(u32, u32)]>,
+        height: u32,
+    },
+}
+
+/// Bounds that stop runaway programs (e.g. `n(x+1) :- n(x).`).
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Total tuples over all relations.
+    pub max_tuples: usize,
+    /// Semi-naive iterations per stratum.
+    pub max_iterations: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_tuples: 50_000_000,
+            max_iterations: 100_000,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    pub provenance: bool,
+    pub limits: Limits,
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RunStats {
+    pub iterations: usize,
+    pub tuples: usize,
+}
+
+pub struct Engine {
+    pub(crate) program: Arc<Program>,
+    pub(crate) rels: Vec<Relation>,
+    pub(crate) prov: Option<Vec<Vec<Prov>>>,
+    /// Compiled rules, per stratum.
+    strata: Vec<Vec<CRule>>,
+    options: Options,
+    ran: bool,
+}
+
+type Cont<'k> = dyn FnMut(&mut Exec<'_>, &mut Vec<Value>) -> Result<(), String> + 'k;
+
+pub(crate) struct Exec<'a> {
+    rels: &'a [Relation],
+    /// Per relation: (end of old tuples, end of tuples visible this iteration).
+    lim: &'a [(u32, u32)],
+    pub(crate) trail: Vec<(u32, u32)>,
+}
+
+impl Engine {
+    pub fn new(program: Arc<Program>, options: Options) -> Engine {
+        let mut rels: Vec<Relation> = program
+            .relations
+            .iter()
+            .map(|r| Relation::new(r.arity()))
+            .collect();
+        let mut strata = Vec::new();
+        for s in &program.strata {
+            let mut in_stratum = vec![false; rels.len()];
+            for &r in &s.relations {
+                in_stratum[r] = true;
+            }
+            strata.push(
+                s.rules
+                    .iter()
+                    .map(|&id| compile::compile_rule(&program, id, &mut rels, &in_stratum))
+                    .collect(),
+            );
+        }
+        let prov = options.provenance.then(|| vec![Vec::new(); rels.len()]);
+        Engine {
+            program,
+            rels,
+            prov,
+            strata,
+            options,
+            ran: false,
+        }
+    }
+
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
+    pub(crate) fn rel_id(&self, name: &str) -> Result<usize, LogicError> {
+        self.program
+            .rel_index
+            .get(name)
+            .copied()
+            .ok_or_else(|| LogicError::Usage(format!("unknown relation `{name}`")))
+    }
+
+    /// Check a tuple against the relation's declared types.
+    pub(crate) fn check_tuple(&self, rel: usize, tuple: &[Value]) -> Result<(), LogicError> {
+        let d = &self.program.relations[rel];
+        if d.arity() != tuple.len() {
+            return Err(LogicError::Usage(format!(
+                "relation `{}` has {} attributes, tuple has {}",
+                d.name,
+                d.arity(),
+                tuple.len()
+            )));
+        }
+        for (a, v) in d.attrs.iter().zip(tuple) {
+            if a.ty != v.ty() {
+                return Err(LogicError::Usage(format!(
+                    "attribute `{}` of `{}` is a {}, got the {} {v}",
+                    a.name,
+                    d.name,
+                    a.ty,
+                    v.ty()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Add an input tuple; returns false if it was already present.
+    pub fn insert(
+        &mut self,
+        rel: &str,
+        tuple: Vec<Value>,
+        origin: Origin,
+    ) -> Result<bool, LogicError> {
+        let r = self.rel_id(rel)?;
+        self.check_tuple(r, &tuple)?;
+        if self.ran {
+            return Err(LogicError::Usage(
+                "facts must be inserted before `run`; create a new Engine to run again".into(),
+            ));
+        }
+        match self.rels[r].insert(&tuple) {
+            Some(_) => {
+                if let Some(p) = &mut self.prov {
+                    p[r].push(Prov::Input(origin));
+                }
+                Ok(true)
+            }
+            None => Ok(false),
+        }
+    }
+
+    /// Evaluate every stratum to its fixpoint.
+    pub fn run(&mut self) -> Result<RunStats, LogicError> {
+        if self.ran {
+            return Err(LogicError::Usage(
+                "this engine has already run; create a new Engine".into(),
+            ));
+        }
+        self.ran = true;
+        let mut stats = RunStats::default();
+        let strata = std::mem::take(&mut self.strata);
+        let result = (|| -> Result<(), LogicError> {
+            for (si, rules) in strata.iter().enumerate() {
+                self.run_stratum(si, rules, &mut stats)?;
+            }
+            Ok(())
+        })();
+        self.strata = strata;
+        result?;
+        stats.tuples = self.rels.iter().map(Relation::len).sum();
+        Ok(stats)
+    }
+
+    fn run_stratum(
+        &mut self,
+        si: usize,
+        rules: &[CRule],
+        stats: &mut RunStats,
+    ) -> Result<(), LogicError> {
+        let members = self.program.strata[si].relations.clone();
+        let mut lim: Vec<(u32, u32)> = self
+            .rels
+            .iter()
+            .map(|r| (r.len() as u32, r.len() as u32))
+            .collect();
+        for &m in &members {
+            lim[m].0 = 0;
+        }
+        let mut iteration = 0usize;
+        loop {
+            let mut produced: Vec<(usize, Vec<Value>, Vec<RecordedBody>)> = Vec::new();
+            for rule in rules {
+                if iteration > 0 && !rule.recursive {
+                    continue;
+                }
+                let (vals, provs) = self.eval_rule(rule, &lim)?;
+                if !vals.is_empty() || (self.rels[rule.head_rel].arity == 0 && !provs.is_empty()) {
+                    produced.push((rule.id, vals, provs));
+                }
+            }
+            let mut grew = false;
+            let mut best: Option<(usize, usize)> = None;
+            for (rule_id, vals, provs) in produced {
+                let head = self.program.rel_index[&self.program.rules[rule_id].head.rel];
+                let arity = self.rels[head].arity;
+                let n = vals.len().checked_div(arity).unwrap_or(provs.len());
+                let mut added = 0usize;
+                for k in 0..n {
+                    let t = if arity == 0 {
+                        &[][..]
+                    } else {
+                        &vals[k * arity..(k + 1) * arity]
+                    };
+                    if self.rels[head].insert(t).is_some() {
+                        added += 1;
+                        if let Some(p) = &mut self.prov {
+                            let (rule, body) = provs[k].clone();
+                            let height = 1 + body
+                                .iter()
+                                .map(|&(r, id)| prov_height(&p[r as usize][id as usize]))
+                                .max()
+                                .unwrap_or(0);
+                            p[head].push(Prov::Derived { rule, body, height });
+                        }
+                    }
+                }
+                if added > 0 {
+                    grew = true;
+                    if best.is_none_or(|(_, a)| added > a) {
+                        best = Some((rule_id, added));
+                    }
+                }
+            }
+            let total: usize = self.rels.iter().map(Relation::len).sum();
+            if total > self.options.limits.max_tuples {
+                let rule = best.map(|(r, _)| r).unwrap_or(rules[0].id);
+                return Err(LogicError::Limit {
+                    message: format!(
+                        "more than {} tuples (limit) after {} iteration(s) of the stratum of {}; rule {} `{}` keeps adding tuples",
+                        self.options.limits.max_tuples,
+                        iteration + 1,
+                        self.stratum_names(si),
+                        self.program.rule_name(rule),
+                        self.program.rules[rule]
+                    ),
+                    hint: "a rule that computes new values from its own output (e.g. `n(x+1) :- n(x).`) never stops; bound it with a condition such as `x < 100`, or raise the limit (--max-tuples)".into(),
+                });
+            }
+            iteration += 1;
+            stats.iterations += 1;
+            if !grew || !self.program.strata[si].recursive {
+                break;
+            }
+            if iteration >= self.options.limits.max_iterations {
+                let rule = best.map(|(r, _)| r).unwrap_or(rules[0].id);
+                return Err(LogicError::Limit {
+                    message: format!(
+                        "the stratum of {} still grows after {} iterations (limit); rule {} `{}` keeps adding tuples",
+                        self.stratum_names(si),
+                        iteration,
+                        self.program.rule_name(rule),
+                        self.program.rules[rule]
+                    ),
+                    hint: "a rule that computes new values from its own output (e.g. `n(x+1) :- n(x).`) never stops; bound it with a condition such as `x < 100`, or raise the limit (--max-iterations)".into(),
+                });
+            }
+            for &m in &members {
+                lim[m] = (lim[m].1, self.rels[m].len() as u32);
+            }
+        }
+        Ok(())
+    }
+
+    fn stratum_names(&self, si: usize) -> String {
+        let names: Vec<String> = self.program.strata[si]
+            .relations
+            .iter()
+            .map(|&r| format!("`{}`", self.program.relations[r].name))
+            .collect();
+        names.join(", ")
+    }
+
+    /// All head tuples a rule derives this iteration that are not yet stored.
+    #[allow(clippy::type_complexity)]
+    fn eval_rule(
+        &self,
+        rule: &CRule,
+        lim: &[(u32, u32)],
+    ) -> Result<(Vec<Value>, Vec<(u32, Box<[(u32, u32)]>)>), LogicError> {
+        let mut out: Vec<Value> = Vec::new();
+        let mut provs: Vec<(u32, Box<[(u32, u32)]>)> = Vec::new();
+        let head_rel = &self.rels[rule.head_rel];
+        let want_prov = self.prov.is_some() || head_rel.arity == 0;
+        let mut env = vec![Value::Number(0); rule.slot_names.len()];
+        let mut ex = Exec {
+            rels: &self.rels,
+            lim,
+            trail: Vec::new(),
+        };
+        let mut tuple = Vec::with_capacity(head_rel.arity);
+        for steps in &rule.variants {
+            let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
+                tuple.clear();
+                for e in &rule.head {
+                    tuple.push(eval::eval(e, env)?);
+                }
+                if head_rel.find(&tuple).is_none() {
+                    out.extend(tuple.iter().cloned());
+                    if want_prov {
+                        provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));
+                    }
+                }
+                Ok(())
+            };
+            ex.run(steps, &mut env, &mut emit)
+                .map_err(|msg| self.runtime_error(rule, &env, msg))?;
+        }
+        Ok((out, provs))
+    }
+
+    fn runtime_error(&self, rule: &CRule, env: &[Value], message: String) -> LogicError {
+        let bindings: Vec<String> = rule
+            .slot_names
+            .iter()
+            .zip(env)
+            .filter(|(n, _)| !n.starts_with("__"))
+            .map(|(n, v)| format!("{n} = {}", show(v)))
+            .collect();
+        LogicError::Runtime {
+            rule: self.program.rule_name(rule.id),
+            rule_text: self.program.rules[rule.id].to_string(),
+            bindings: if bindings.is_empty() {
+                "no variables".into()
+            } else {
+                bindings.join(", ")
+            },
+            message,
+        }
+    }
+
+    /// The tuples of a relation, sorted.
+    pub fn relation(&self, name: &str) -> Result<Vec<Vec<Value>>, LogicError> {
+        Ok(self.rels[self.rel_id(name)?].sorted())
+    }
+
+    /// Whether the relation holds the tuple.
+    pub fn contains(&self, name: &str, tuple: &[Value]) -> Result<bool, LogicError> {
+        Ok(self.rels[self.rel_id(name)?].find(tuple).is_some())
+    }
+
+    pub(crate) fn compiled_rules(&self) -> impl Iterator<Item = &CRule> {
+        self.strata.iter().flatten()
+    }
+
+    pub fn len(&self, name: &str) -> Result<usize, LogicError> {
+        Ok(self.rels[self.rel_id(name)?].len())
+    }
+}
+
+/// Rule index and the body tuples of one derivation.
+type RecordedBody = (u32, Box<[(u32, u32)]>);
+
+fn prov_height(p: &Prov) -> u32 {
+    match p {
+        Prov::Input(_) => 0,
+        Prov::Derived { height, .. } => *height,
+    }
+}
+
+pub(crate) fn show(v: &Value) -> String {
+    match v {
+        Value::Symbol(s) => format!("{:?}", &**s),
+        other => other.to_string(),
+    }
+}
+
+impl<'a> Exec<'a> {
+    pub(crate) fn new(rels: &'a [Relation], lim: &'a [(u32, u32)]) -> Self {
+        Exec {
+            rels,
+            lim,
+            trail: Vec::new(),
+        }
+    }
+
+    pub(crate) fn run(
+        &mut self,
+        steps: &[CStep],
+        env: &mut Vec<Value>,
+        k: &mut Cont<'_>,
+    ) -> Result<(), String> {
+        let Some((step, rest)) = steps.split_first() else {
+            return k(self, env);
+        };
+        match step {
+            CStep::Scan {
+                rel,
+                index,
+                key,
+                binds,
+                checks,
+                range,
+                ..
+            } => {
+                let r: &'a Relation = &self.rels[*rel];
+                let (old, end) = self.lim[*rel];
+                let (lo, hi) = match range {
+                    Range::Full => (0, end),
+                    Range::Old => (0, old),
+                    Range::Delta => (old, end),
+                };
+                if lo >= hi {
+                    return Ok(());
+                }
+                match index {
+                    None => {
+                        for id in lo..hi {
+                            self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                        }
+                    }
+                    Some(ix) => {
+                        let keyv: Vec<Value> = key
+                            .iter()
+                            .map(|e| eval::eval(e, env))
+                            .collect::<Result<_, _>>()?;
+                        let index = &r.indexes[*ix];
+                        let ids = index.get(hash_values(keyv.iter()));
+                        let start = ids.partition_point(|&i| i < lo);
+                        for &id in &ids[start..] {
+                            if id >= hi {
+                                break;
+                            }
+                            let t = r.tuple(id);
+                            if index.cols.iter().zip(&keyv).all(|(&c, v)| &t[c] == v) {
+                                self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                            }
+                        }
+                    }
+                }
+                Ok(())
+            }
+            CStep::Negate {
+                rel,
+                index,
+                key,
+                all,
+            } => {
+                let r = &self.rels[*rel];
+                let keyv: Vec<Value> = key
+                    .iter()
+                    .map(|e| eval::eval(e, env))
+                    .collect::<Result<_, _>>()?;
+                let exists = if *all {
+                    r.find(&keyv).is_some()
+                } else {
+                    match index {
+                        None => !r.is_empty(),
+                        Some(ix) => {
+                            let index = &r.indexes[*ix];
+                            index.get(hash_values(keyv.iter())).iter().any(|&id| {
+                                let t = r.tuple(id);
+                                index.cols.iter().zip(&keyv).all(|(&c, v)| &t[c] == v)
+                            })
+                        }
+                    }
+                };
+                if exists {
+                    Ok(())
+                } else {
+                    self.run(rest, env, k)
+                }
+            }
+            CStep::Filter(op, _, a, b) => {
+                if compare(*op, &eval::eval(a, env)?, &eval::eval(b, env)?) {
+                    self.run(rest, env, k)
+                } else {
+                    Ok(())
+                }
+            }
+            CStep::StrTest {
+                is_match,
+                negated,
+                a,
+                b,
+            } => {
+                let (x, y) = (eval::eval(a, env)?, eval::eval(b, env)?);
+                let (x, y) = (x.as_symbol().unwrap_or(""), y.as_symbol().unwrap_or(""));
+                let holds = if *is_match {
+                    super::ops::regex_match(x, y)?
+                } else {
+                    super::ops::contains(x, y)
+                };
+                if holds != *negated {
+                    self.run(rest, env, k)
+                } else {
+                    Ok(())
+                }
+            }
+            CStep::Assign(slot, e) => {
+                env[*slot as usize] = eval::eval(e, env)?;
+                self.run(rest, env, k)
+            }
+            CStep::AggAssign(slot, agg) => match self.aggregate(agg, env)? {
+                Some(v) => {
+                    env[*slot as usize] = v;
+                    self.run(rest, env, k)
+                }
+                None => Ok(()),
+            },
+            CStep::AggFilter {
+                op,
+                other,
+                agg,
+                agg_left,
+                ..
+            } => {
+                let Some(v) = self.aggregate(agg, env)? else {
+                    return Ok(());
+                };
+                let o = eval::eval(other, env)?;
+                let holds = if *agg_left {
+                    compare(*op, &v, &o)
+                } else {
+                    compare(*op, &o, &v)
+                };
+                if holds {
+                    self.run(rest, env, k)
+                } else {
+                    Ok(())
+                }
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn visit(
+        &mut self,
+        rel: usize,
+        r: &Relation,
+        id: u32,
+        binds: &[(usize, u32)],
+        checks: &[(usize, compile::CExpr)],
+        rest: &[CStep],
+        env: &mut Vec<Value>,
+        k: &mut Cont<'_>,
+    ) -> Result<(), String> {
+        let t = r.tuple(id);
+        for &(c, s) in binds {
+            env[s as usize] = t[c].clone();
+        }
+        for (c, e) in checks {
+            if eval::eval(e, env)? != t[*c] {
+                return Ok(());
+            }
+        }
+        self.trail.push((rel as u32, id));
+        let res = self.run(rest, env, k);
+        self.trail.pop();
+        res
+    }
+
+    /// Value of an aggregate for the current bindings (None: min/max/mean of nothing).
+    pub(crate) fn aggregate(
+        &mut self,
+        agg: &CAgg,
+        env: &mut Vec<Value>,
+    ) -> Result<Option<Value>, String> {
+        let mut count: i64 = 0;
+        let mut acc: Option<Value> = None;
+        let mut fsum = 0.0f64;
+        let trail_len = self.trail.len();
+        {
+            let mut k = |_: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
+                count += 1;
+                if let Some(t) = &agg.target {
+                    let v = eval::eval(t, env)?;
+                    match agg.op {
+                        AggOp::Mean => fsum += numeric_f64(&v),
+                        AggOp::Sum => {
+                            acc = Some(match (acc.take(), v) {
+                                (None, v) => v,
+                                (Some(Value::Number(a)), Value::Number(b)) => {
+                                    Value::Number(a.wrapping_add(b))
+                                }
+                                (Some(Value::Unsigned(a)), Value::Unsigned(b)) => {
+                                    Value::Unsigned(a.wrapping_add(b))
+                                }
+                                (Some(Value::Float(a)), Value::Float(b)) => Value::float(a.0 + b.0),
+                                (Some(a), _) => a,
+                            })
+                        }
+                        AggOp::Min | AggOp::Max => {
+                            let better = match &acc {
+                                None => true,
+                                // Total order (floats too), so the result does not depend on visiting order.
+                                Some(a) => {
+                                    (agg.op == AggOp::Min && v < *a)
+                                        || (agg.op == AggOp::Max && v > *a)
+                                }
+                            };
+                            if better {
+                                acc = Some(v);
+                            }
+                        }
+                        AggOp::Count => {}
+                    }
+                }
+                Ok(())
+            };
+            self.run(&agg.steps, env, &mut k)?;
+        }
+        self.trail.truncate(trail_len);
+        Ok(match agg.op {
+            AggOp::Count => Some(Value::Number(count)),
+            AggOp::Sum => Some(acc.unwrap_or(match agg.ty {
+                BaseTy::Unsigned => Value::Unsigned(0),
+                BaseTy::Float => Value::float(0.0),
+                _ => Value::Number(0),
+            })),
+            AggOp::Min | AggOp::Max => acc,
+            AggOp::Mean => (count > 0).then(|| Value::float(fsum / count as f64)),
+        })
+    }
+}
+
+fn numeric_f64(v: &Value) -> f64 {
+    match v {
+        Value::Number(n) => *n as f64,
+        Value::Unsigned(n) => *n as f64,
+        Value::Float(f) => f.0,
+        _ => 0.0,
+    }
+}

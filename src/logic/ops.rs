@@ -1,0 +1,174 @@
+//! Typed operations of the language (arithmetic, string functors), shared by
+//! the interpreter and the compiled engine so both compute the same values.
+//! `Err` carries the message of a runtime error (the caller names the rule).
+
+use super::value::{F64, Sym, format_float};
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+pub type OpResult<T> = Result<T, String>;
+
+pub fn div_i64(a: i64, b: i64) -> OpResult<i64> {
+    if b == 0 {
+        return Err(format!("division by zero ({a} / 0)"));
+    }
+    Ok(a.wrapping_div(b))
+}
+pub fn rem_i64(a: i64, b: i64) -> OpResult<i64> {
+    if b == 0 {
+        return Err(format!("division by zero ({a} % 0)"));
+    }
+    Ok(a.wrapping_rem(b))
+}
+/// Integer power; a negative exponent goes through floating point and
+/// truncates (`2 ^ -1 = 0`), as Soufflé computes it.
+pub fn pow_i64(a: i64, e: i64) -> i64 {
+    if e < 0 {
+        return (a as f64).powf(e as f64) as i64;
+    }
+    pow_wrapping(a as u64, e as u64) as i64
+}
+pub fn pow_u64(a: u64, e: u64) -> u64 {
+    pow_wrapping(a, e)
+}
+fn pow_wrapping(mut base: u64, mut e: u64) -> u64 {
+    let mut acc: u64 = 1;
+    while e > 0 {
+        if e & 1 == 1 {
+            acc = acc.wrapping_mul(base);
+        }
+        base = base.wrapping_mul(base);
+        e >>= 1;
+    }
+    acc
+}
+pub fn div_u64(a: u64, b: u64) -> OpResult<u64> {
+    if b == 0 {
+        return Err(format!("division by zero ({a} / 0)"));
+    }
+    Ok(a / b)
+}
+pub fn rem_u64(a: u64, b: u64) -> OpResult<u64> {
+    if b == 0 {
+        return Err(format!("division by zero ({a} % 0)"));
+    }
+    Ok(a % b)
+}
+
+pub fn cat(parts: &[&str]) -> Sym {
+    Arc::from(parts.concat().as_str())
+}
+/// Length in bytes, as Soufflé's `strlen`.
+pub fn strlen(s: &str) -> i64 {
+    s.len() as i64
+}
+/// Bytes `[start, start+len)` (len clipped at the end of the string).
+pub fn substr(s: &str, start: i64, len: i64) -> OpResult<Sym> {
+    if start < 0 || start as usize > s.len() || len < 0 {
+        return Err(format!(
+            "substr({s:?}, {start}, {len}): start or length out of range (string has {} bytes)",
+            s.len()
+        ));
+    }
+    let end = (start as usize).saturating_add(len as usize).min(s.len());
+    s.get(start as usize..end)
+        .map(Arc::from)
+        .ok_or_else(|| format!("substr({s:?}, {start}, {len}) would split a UTF-8 character"))
+}
+/// A process-wide ordinal per distinct symbol (first use gets the next number).
+pub fn ord(s: &str) -> i64 {
+    static TABLE: OnceLock<Mutex<HashMap<String, i64>>> = OnceLock::new();
+    let mut t = TABLE
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    let n = t.len() as i64;
+    *t.entry(s.to_string()).or_insert(n)
+}
+pub fn to_number(s: &str) -> OpResult<i64> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("to_number({s:?}): not a number"))
+}
+pub fn to_unsigned(s: &str) -> OpResult<u64> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("to_unsigned({s:?}): not an unsigned number"))
+}
+pub fn to_float(s: &str) -> OpResult<F64> {
+    s.trim()
+        .parse()
+        .map(F64)
+        .map_err(|_| format!("to_float({s:?}): not a float"))
+}
+pub fn i64_to_string(n: i64) -> Sym {
+    Arc::from(n.to_string().as_str())
+}
+pub fn u64_to_string(n: u64) -> Sym {
+    Arc::from(n.to_string().as_str())
+}
+pub fn f64_to_string(x: F64) -> Sym {
+    Arc::from(format_float(x.0).as_str())
+}
+pub fn contains(needle: &str, hay: &str) -> bool {
+    hay.contains(needle)
+}
+
+/// Whole-string regular-expression match (like `std::regex_match`).
+pub fn regex_match(pattern: &str, text: &str) -> OpResult<bool> {
+    thread_local! {
+        static CACHE: RefCell<HashMap<String, regex::Regex>> = RefCell::new(HashMap::new());
+    }
+    CACHE.with(|c| {
+        let mut c = c.borrow_mut();
+        if !c.contains_key(pattern) {
+            let re = regex::Regex::new(&format!("^(?:{pattern})$"))
+                .map_err(|e| format!("match: bad regular expression {pattern:?}: {e}"))?;
+            if c.len() > 1024 {
+                c.clear();
+            }
+            c.insert(pattern.to_string(), re);
+        }
+        Ok(c[pattern].is_match(text))
+    })
+}
+
+/// IEEE comparison for floats (NaN compares false, -0 equals 0), as in Soufflé.
+pub fn float_cmp(op: super::front::ast::CmpOp, a: f64, b: f64) -> bool {
+    use super::front::ast::CmpOp::*;
+    match op {
+        Eq => a == b,
+        Ne => a != b,
+        Lt => a < b,
+        Le => a <= b,
+        Gt => a > b,
+        Ge => a >= b,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arithmetic_edges() {
+        assert!(div_i64(1, 0).is_err());
+        assert_eq!(div_i64(i64::MIN, -1).unwrap(), i64::MIN);
+        assert_eq!(pow_i64(2, 10), 1024);
+        assert_eq!(pow_i64(2, -1), 0);
+        assert_eq!(rem_i64(-7, 3).unwrap(), -1);
+    }
+
+    #[test]
+    fn strings() {
+        assert_eq!(&*substr("hello", 1, 3).unwrap(), "ell");
+        assert_eq!(&*substr("hello", 3, 10).unwrap(), "lo");
+        assert!(substr("hello", 6, 1).is_err());
+        assert!(regex_match("a.*c", "abc").unwrap());
+        assert!(!regex_match("b", "abc").unwrap());
+        assert!(regex_match("(", "x").is_err());
+        assert_eq!(to_number(" 42 ").unwrap(), 42);
+        assert!(to_number("4x").is_err());
+    }
+}

@@ -1,0 +1,70 @@
+//! Every program in rules/ and tests/logic/ gives identical relations on the
+//! interpreter and on its compiled (ascent) form.
+
+use framewright::logic::compiled::{self, Relations};
+use framewright::logic::{Engine, Options, Program, io};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn dl_files(dir: &str) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(root().join(dir))
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.ends_with(".dl"))
+                .map(|n| format!("{dir}/{n}"))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The program's input relations, read from the facts directory beside it (if any).
+fn inputs(program: &Arc<Program>, facts: &Path) -> Relations {
+    let mut e = Engine::new(program.clone(), Options::default());
+    if facts.is_dir() {
+        io::load_inputs(&mut e, facts).unwrap();
+    }
+    program
+        .relations
+        .iter()
+        .filter(|r| r.input.is_some())
+        .map(|r| (r.name.clone(), e.relation(&r.name).unwrap()))
+        .collect()
+}
+
+#[test]
+fn interpreter_and_compiled_agree_on_every_program() {
+    let mut files = dl_files("rules");
+    files.extend(dl_files("tests/logic"));
+    files.extend(dl_files("benches/logic"));
+    assert!(files.len() >= 5);
+    for rel in files {
+        let path = root().join(&rel);
+        let program = Arc::new(Program::parse_files(&[&path]).unwrap());
+        let facts = path.with_extension("");
+        let edb = inputs(&program, &facts);
+        let mut engine = Engine::new(program.clone(), Options::default());
+        for (name, tuples) in &edb {
+            for t in tuples {
+                engine
+                    .insert(name, t.clone(), framewright::logic::Origin::Rust)
+                    .unwrap();
+            }
+        }
+        engine.run().unwrap();
+        let run =
+            compiled::program(&rel).unwrap_or_else(|| panic!("{rel} was not compiled by build.rs"));
+        let got = run(&edb).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        for r in &program.relations {
+            let want = engine.relation(&r.name).unwrap();
+            assert_eq!(got[&r.name], want, "{rel}: relation {}", r.name);
+        }
+        println!("{rel}: {} relations agree", program.relations.len());
+    }
+}

@@ -1,0 +1,236 @@
+//! Bad rule programs are rejected with file:line:col, the source line, a caret,
+//! what is wrong and a hint; runtime errors name the rule and the values.
+
+use framewright::logic::{Engine, Limits, LogicError, Options, Program};
+use std::sync::Arc;
+
+const DECLS: &str =
+    ".decl e(x: number, y: number)\n.decl p(x: number, y: number)\n.decl s(n: symbol)\n";
+
+/// Check `body` (appended after DECLS) fails at `line:col` with a message containing `what`.
+fn fails(body: &str, line: u32, col: u32, what: &str) -> String {
+    let text = format!("{DECLS}{body}");
+    let err = Program::parse_str("prog.dl", &text).expect_err("program should be rejected");
+    let d = &err.0[0];
+    let shown = err.to_string();
+    assert!(d.message.contains(what), "expected `{what}` in:\n{shown}");
+    assert_eq!((d.line, d.col), (line, col), "position of:\n{shown}");
+    assert!(
+        shown.starts_with(&format!("prog.dl:{line}:{col}: error: ")),
+        "{shown}"
+    );
+    assert!(shown.contains('^') && shown.contains("hint: "), "{shown}");
+    assert!(!d.hint.is_empty());
+    shown
+}
+
+#[test]
+fn syntax_errors() {
+    fails("p(x, y) :- e(x, y)\n", 5, 1, "expected `.`");
+    fails("p(x, y) :- e(x y).\n", 4, 16, "expected `)`");
+    fails("p(x, y) :- e(x, \"y).\n", 4, 17, "unterminated string");
+    fails("#include \"x.dl\"\n", 4, 1, "preprocessor");
+}
+
+#[test]
+fn unknown_relation_and_arity() {
+    let s = fails("p(x, y) :- ee(x, y).\n", 4, 12, "unknown relation `ee`");
+    assert!(s.contains("did you mean `e`"), "{s}");
+    fails(
+        "p(x, y) :- e(x, y, 1).\n",
+        4,
+        12,
+        "2 attribute(s) but is used with 3",
+    );
+    fails(".output q\n", 4, 9, "unknown relation `q`");
+}
+
+#[test]
+fn type_errors() {
+    fails("p(x, y) :- e(x, y), s(x).\n", 4, 23, "type mismatch");
+    fails("s(x) :- e(x, _).\n", 4, 11, "type mismatch");
+    fails("p(x, y) :- e(x, y), y = \"a\".\n", 4, 25, "type mismatch");
+    fails(
+        ".type A <: symbol\n.type B <: symbol\n.decl a(x: A)\n.decl b(x: B)\na(x) :- b(x).\n",
+        8,
+        11,
+        "neither is a subtype",
+    );
+    fails(".decl q(x: nubmer)\n", 4, 9, "unknown type `nubmer`");
+}
+
+#[test]
+fn groundedness() {
+    fails(
+        "p(x, y) :- e(x, _).\n",
+        4,
+        6,
+        "variable `y` in the head is not grounded",
+    );
+    fails(
+        "p(x, y) :- e(x, x), !e(y, x).\n",
+        4,
+        22,
+        "variable `y` is not grounded",
+    );
+    fails(
+        "p(x, y) :- e(x, x), y < x.\n",
+        4,
+        23,
+        "variable `y` is not grounded",
+    );
+}
+
+#[test]
+fn negation_and_aggregation_cycles_name_the_cycle() {
+    let s = fails(
+        "p(x, y) :- e(x, y), !p(y, x).\n",
+        4,
+        22,
+        "inside a recursive cycle: p -> p",
+    );
+    assert!(s.contains("stratifiable"), "{s}");
+    let s = fails(
+        ".decl a(x: number)\n.decl b(x: number)\na(x) :- e(x, _), !b(x).\nb(x) :- a(x).\n",
+        6,
+        19,
+        "a -> b -> a",
+    );
+    assert!(s.contains("negation or aggregation of `b`"), "{s}");
+    fails(
+        ".decl c(n: number)\nc(n) :- c(m), n = count : { c(m) }.\n",
+        5,
+        29,
+        "recursive cycle",
+    );
+}
+
+#[test]
+fn unknown_functors() {
+    let s = fails(
+        ".decl f(x: float)\nf(@distt(@vec3(1.0, 2.0, 3.0), @vec3(0.0, 0.0, 0.0))).\n",
+        5,
+        3,
+        "unknown functor `@distt`",
+    );
+    assert!(s.contains("did you mean `@dist`"), "{s}");
+    fails(
+        "p(x, y) :- e(x, y), y = foo(x).\n",
+        4,
+        25,
+        "unknown functor `foo`",
+    );
+    fails(
+        ".decl f(x: float)\nf(@dist(1.0)).\n",
+        5,
+        3,
+        "takes 2 argument(s)",
+    );
+}
+
+#[test]
+fn unsupported_soufflé_features_are_named() {
+    fails(
+        ".type R = [a: number, b: number]\n",
+        4,
+        11,
+        "record types are not supported",
+    );
+    fails(
+        ".type T = A {x: number} | B {}\n",
+        4,
+        13,
+        "algebraic data types are not supported",
+    );
+    fails(
+        ".comp C { }\n",
+        4,
+        1,
+        "components (`.comp`) is not supported",
+    );
+    fails(".init c = C\n", 4, 1, "component instances");
+    fails("p(x, y) <= p(x, z) :- y < z.\n", 4, 9, "subsumption");
+    fails(".decl c(x: number) choice-domain x\n", 4, 20, "choice");
+    fails(".type U = number | symbol\n", 4, 18, "union types");
+    fails(
+        ".functor f(number): number\n",
+        4,
+        1,
+        "user-defined functors",
+    );
+    fails("p(x, y) :- e(x, y), x = $.\n", 4, 25, "`$`");
+    fails(".decl q(x: number) eqrel\n", 4, 20, "eqrel");
+    fails("p(x, y) :- e(x, y), x = y band 1.\n", 4, 27, "bitwise");
+}
+
+#[test]
+fn include_errors_point_at_the_directive() {
+    fails(
+        ".include \"no/such/file.dl\"\n",
+        4,
+        10,
+        "cannot read rule file",
+    );
+}
+
+fn run_err(text: &str, limits: Limits) -> LogicError {
+    let p = Arc::new(Program::parse_str("rt.dl", text).unwrap_or_else(|e| panic!("{e}")));
+    let mut e = Engine::new(
+        p,
+        Options {
+            provenance: false,
+            limits,
+        },
+    );
+    e.run().expect_err("run should fail")
+}
+
+#[test]
+fn runtime_errors_name_the_rule_and_the_values() {
+    let err = run_err(
+        ".decl a(x: number)\na(0). a(4).\n.decl b(x: number)\n// @rule ratio\nb(8 / x) :- a(x).\n",
+        Limits::default(),
+    );
+    let s = err.to_string();
+    assert!(
+        s.contains("division by zero") && s.contains("ratio (rt.dl:5)") && s.contains("x = 0"),
+        "{s}"
+    );
+    let err = run_err(
+        ".decl a(x: symbol)\na(\"12\"). a(\"twelve\").\n.decl b(x: number)\nb(to_number(x)) :- a(x).\n",
+        Limits::default(),
+    );
+    let s = err.to_string();
+    assert!(
+        s.contains("to_number(\"twelve\")")
+            && s.contains("rt.dl:4")
+            && s.contains("x = \"twelve\""),
+        "{s}"
+    );
+}
+
+#[test]
+fn unbounded_value_creation_is_stopped_by_the_limits() {
+    let prog = ".decl n(x: number)\nn(0).\n// @rule succ\nn(x + 1) :- n(x).\n";
+    let err = run_err(
+        prog,
+        Limits {
+            max_tuples: 1_000_000,
+            max_iterations: 500,
+        },
+    );
+    let s = err.to_string();
+    assert!(matches!(err, LogicError::Limit { .. }), "{s}");
+    assert!(
+        s.contains("succ (rt.dl:4)") && s.contains("500 iterations") && s.contains("x < 100"),
+        "{s}"
+    );
+    let err = run_err(
+        prog,
+        Limits {
+            max_tuples: 300,
+            max_iterations: 100_000,
+        },
+    );
+    assert!(err.to_string().contains("more than 300 tuples"), "{err}");
+}
