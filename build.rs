@@ -1,4 +1,4 @@
-//! Compiles the rule programs `rules/*.dl` (built-in rule base),
+//! Compiles the rule programs `rules/*.dl` (the built-in rule base, one program),
 //! `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
 //! using the same parser and checker as the interpreter.
 
@@ -75,15 +75,24 @@ fn main() {
     for dir in ["rules", "tests/logic", "benches/logic"] {
         println!("cargo:rerun-if-changed={dir}");
         let abs = root.join(dir);
-        // Included fragments live in subdirectories; watch them too.
         if let Ok(rd) = std::fs::read_dir(&abs) {
             for e in rd.flatten() {
                 println!("cargo:rerun-if-changed={}", e.path().display());
             }
         }
-        for file in dl_files(&abs) {
-            let rel = format!("{dir}/{}", file.file_name().unwrap().to_string_lossy());
-            let program = match front::load_files(std::slice::from_ref(&file), SIGS) {
+        let files = dl_files(&abs);
+        // The built-in rule base is one program over all of rules/*.dl; the
+        // test and bench programs are one program per file.
+        let units: Vec<(String, Vec<PathBuf>)> = if dir == "rules" {
+            if files.is_empty() { Vec::new() } else { vec![(dir.to_string(), files)] }
+        } else {
+            files
+                .into_iter()
+                .map(|f| (format!("{dir}/{}", f.file_name().unwrap().to_string_lossy()), vec![f]))
+                .collect()
+        };
+        for (rel, files) in units {
+            let program = match front::load_files(&files, SIGS) {
                 Ok(p) => p,
                 Err(e) => panic!("rule program {rel} does not check:\n{e}"),
             };

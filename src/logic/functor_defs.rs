@@ -56,6 +56,20 @@ functor_table! {
     fn round_to(x: F64, step: F64) -> F64 {
         F64(if step.0 > 0.0 { (x.0 / step.0).round() * step.0 } else { x.0 })
     }
+    /// Half the extent of a box along a direction (its projected radius).
+    fn box_radius(b: OBox, d: Vec3) -> F64 {
+        let n = d.0.norm();
+        F64(if n == 0.0 { 0.0 } else { (0..3).map(|k| b.half[k] * b.axis(k).dot(&d.0).abs()).sum::<f64>() / n })
+    }
+    /// A frame with origin `o`, x axis `u`, y axis `v` and z axis `u × v`
+    /// (u and v are orthonormalised; v is kept as given when u is parallel to it).
+    fn frame(o: Vec3, u: Vec3, v: Vec3) -> Iso {
+        let u = u.0.try_normalize(1e-12).unwrap_or_else(nalgebra::Vector3::x);
+        let v = (v.0 - u * u.dot(&v.0)).try_normalize(1e-12).unwrap_or_else(|| u.cross(&nalgebra::Vector3::z()).try_normalize(1e-12).unwrap_or_else(nalgebra::Vector3::y));
+        let m = nalgebra::Matrix3::from_columns(&[u, v, u.cross(&v)]);
+        let r = nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(m));
+        Iso(nalgebra::Isometry3::from_parts(nalgebra::Translation3::from(o.0), r))
+    }
     fn abs(x: F64) -> F64 { F64(x.0.abs()) }
     fn sqrt(x: F64) -> F64 { F64(x.0.sqrt()) }
 }
