@@ -6,7 +6,9 @@
 //! See `docs/ARCHITECTURE.md` for the codemap.
 
 pub mod cell;
+pub mod geom;
 pub mod ifc;
 pub mod logic;
+pub mod report;
 pub mod step;
 pub mod synth;

@@ -1,1 +1,20 @@
-//! step (being built).
+//! ISO 10303-21 ("STEP physical file") reader. Knows nothing about IFC.
+//!
+//! One pass over the bytes indexes every entity instance as `#id → (type, byte
+//! range)`; parameters are decoded on demand with nom ([`StepFile::entity`]).
+//! Handles comments, `$`, `*`, enums, typed values, nested lists, string
+//! escapes and CR-only line ends.
+
+mod error;
+mod header;
+mod index;
+mod params;
+mod source;
+mod strings;
+
+pub use error::{StepError, StepErrorKind};
+pub use header::Header;
+pub use index::{Record, StepFile, TypeId};
+pub use params::{Entity, Param};
+pub use source::{ReadOptions, Source};
+pub use strings::decode_step_string;

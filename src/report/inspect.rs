@@ -1,0 +1,146 @@
+//! The `inspect` report: what the reader found in a model.
+
+use super::{round_m, round_point};
+use crate::ifc::{LengthUnit, Model, Warning};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+#[derive(Debug, Serialize)]
+pub struct InspectReport {
+    pub schema: String,
+    pub schema_identifier: String,
+    pub length_unit: LengthUnit,
+    pub originating_system: String,
+    pub entity_count: usize,
+    pub members: Vec<MemberRow>,
+    pub warnings: Vec<Warning>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct MemberRow {
+    pub id: String,
+    pub entity: u64,
+    pub global_id: String,
+    pub piece: Option<usize>,
+    pub name: Option<String>,
+    pub ifc_type: String,
+    pub predefined_type: Option<String>,
+    pub parent_global_id: Option<String>,
+    pub material: Option<String>,
+    pub axis_start: [f64; 3],
+    pub axis_end: [f64; 3],
+    pub width: f64,
+    pub thickness: f64,
+    pub length: f64,
+    pub volume: f64,
+}
+
+impl InspectReport {
+    pub fn new(model: &Model) -> Self {
+        let members = model
+            .pieces()
+            .iter()
+            .map(|p| {
+                let (start, end) = p.axis();
+                MemberRow {
+                    id: p.id.clone(),
+                    entity: p.entity,
+                    global_id: p.global_id.clone(),
+                    piece: p.piece,
+                    name: p.name.clone(),
+                    ifc_type: p.ifc_type.clone(),
+                    predefined_type: p.predefined_type.clone(),
+                    parent_global_id: p
+                        .parent
+                        .and_then(|id| model.groups.get(&id))
+                        .map(|g| g.global_id.clone()),
+                    material: p.material.clone(),
+                    axis_start: round_point(&start),
+                    axis_end: round_point(&end),
+                    width: round_m(p.obox.width()),
+                    thickness: round_m(p.obox.thickness()),
+                    length: round_m(p.obox.length()),
+                    volume: (p.obox.volume() * 1e12).round() / 1e12,
+                }
+            })
+            .collect();
+        InspectReport {
+            schema: model.schema.name().to_string(),
+            schema_identifier: model.schema_identifier.clone(),
+            length_unit: model.length_unit.clone(),
+            originating_system: model.header().originating_system.clone(),
+            entity_count: model.entity_count(),
+            members,
+            warnings: model.warnings.clone(),
+        }
+    }
+
+    /// Streams pretty JSON (no second copy of a large report in memory).
+    pub fn write_json(&self, out: &mut impl std::io::Write) -> std::io::Result<()> {
+        serde_json::to_writer_pretty(&mut *out, self)?;
+        out.write_all(b"\n")
+    }
+
+    /// A short summary for a terminal.
+    pub fn to_text(&self) -> String {
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "schema       {} ({})",
+            self.schema, self.schema_identifier
+        );
+        let _ = writeln!(
+            out,
+            "length unit  {} ({} m)",
+            self.length_unit.name, self.length_unit.metres_per_unit
+        );
+        let _ = writeln!(
+            out,
+            "written by   {}",
+            if self.originating_system.is_empty() {
+                "-"
+            } else {
+                &self.originating_system
+            }
+        );
+        let _ = writeln!(out, "entities     {}", self.entity_count);
+        let mut by_type: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+        let mut products = std::collections::BTreeSet::new();
+        for m in &self.members {
+            let slot = by_type.entry(&m.ifc_type).or_default();
+            slot.1 += 1;
+            if products.insert(m.entity) {
+                slot.0 += 1;
+            }
+        }
+        let _ = writeln!(
+            out,
+            "pieces       {} in {} products",
+            self.members.len(),
+            products.len()
+        );
+        for (ifc_type, (count, pieces)) in &by_type {
+            let _ = writeln!(
+                out,
+                "  {ifc_type:<28} {count:>6} products {pieces:>7} pieces"
+            );
+        }
+        if self.warnings.is_empty() {
+            let _ = writeln!(out, "warnings     none");
+        } else {
+            let _ = writeln!(out, "warnings     {}", self.warnings.len());
+            for w in self.warnings.iter().take(20) {
+                let _ = writeln!(out, "  - {}", w.message);
+            }
+            if self.warnings.len() > 20 {
+                let _ = writeln!(
+                    out,
+                    "  … and {} more (see --json)",
+                    self.warnings.len() - 20
+                );
+            }
+        }
+        out
+    }
+}

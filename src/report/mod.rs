@@ -1,0 +1,14 @@
+//! Outputs a person or a program reads. Numbers in JSON are rounded to the
+//! nanometre so that output is stable and free of float noise.
+
+pub mod inspect;
+
+/// Rounds a length to 1e-9 m (and turns -0 into 0).
+pub fn round_m(x: f64) -> f64 {
+    let r = (x * 1e9).round() / 1e9;
+    if r == 0.0 { 0.0 } else { r }
+}
+
+pub fn round_point(p: &crate::geom::Point3) -> [f64; 3] {
+    [round_m(p.x), round_m(p.y), round_m(p.z)]
+}

@@ -1,0 +1,631 @@
+//! The one-pass index: `#id → (type, byte range)` for every entity instance.
+
+use super::error::{StepError, StepErrorKind};
+use super::header::Header;
+use super::params::{self, Entity, skip_ws};
+use super::source::{ReadOptions, Source};
+use rustc_hash::FxHashMap;
+use std::path::Path;
+
+/// Index of an interned entity type name.
+pub type TypeId = u32;
+
+/// Where one entity instance sits in the file.
+#[derive(Debug, Clone, Copy)]
+pub struct Record {
+    pub id: u64,
+    pub type_id: TypeId,
+    /// Byte offset of the `#` that starts the instance.
+    pub start: usize,
+    /// Byte range of the parameter list, parentheses included.
+    pub params: (usize, usize),
+}
+
+/// Ids are looked up in a dense table when they are compact (the usual case),
+/// otherwise by binary search; either way memory is bounded by the entity count.
+enum IdLookup {
+    Dense(Vec<u32>),
+    Sorted(Vec<(u64, u32)>),
+}
+
+pub struct StepFile {
+    source: Source,
+    pub header: Header,
+    records: Vec<Record>,
+    lookup: IdLookup,
+    type_names: Vec<String>,
+    by_type: Vec<Vec<u32>>,
+    max_depth: usize,
+}
+
+const NO_RECORD: u32 = u32::MAX;
+
+impl std::fmt::Debug for StepFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StepFile")
+            .field("header", &self.header)
+            .field("entities", &self.records.len())
+            .finish()
+    }
+}
+
+impl StepFile {
+    pub fn open(path: &Path, options: &ReadOptions) -> Result<StepFile, StepError> {
+        Self::from_source(Source::open(path, options)?, options)
+    }
+
+    pub fn from_bytes(bytes: Vec<u8>, options: &ReadOptions) -> Result<StepFile, StepError> {
+        if bytes.len() as u64 > options.max_bytes {
+            let kind = StepErrorKind::TooLarge {
+                bytes: bytes.len() as u64,
+                limit: options.max_bytes,
+            };
+            return Err(StepError::new(kind));
+        }
+        Self::from_source(Source::Owned(bytes), options)
+    }
+
+    fn from_source(source: Source, options: &ReadOptions) -> Result<StepFile, StepError> {
+        let scan = Scanner::new(source.bytes(), options.max_depth).scan();
+        let (header, raw) = match scan {
+            Ok(v) => v,
+            Err((offset, kind, entity)) => {
+                return Err(located(source.bytes(), offset, kind, entity));
+            }
+        };
+        let mut file = StepFile {
+            header,
+            records: raw.records,
+            lookup: IdLookup::Sorted(Vec::new()),
+            type_names: raw.type_names,
+            by_type: Vec::new(),
+            max_depth: options.max_depth,
+            source,
+        };
+        file.build_lookup()?;
+        file.by_type = vec![Vec::new(); file.type_names.len()];
+        for (i, r) in file.records.iter().enumerate() {
+            file.by_type[r.type_id as usize].push(i as u32);
+        }
+        Ok(file)
+    }
+
+    fn build_lookup(&mut self) -> Result<(), StepError> {
+        let count = self.records.len();
+        let max_id = self.records.iter().map(|r| r.id).max().unwrap_or(0);
+        let duplicate = |first: &Record, second: &Record| {
+            let kind = StepErrorKind::DuplicateId {
+                id: second.id,
+                first_line: self.line_col(first.start).0,
+                first_type: self.type_names[first.type_id as usize].clone(),
+                second_type: self.type_names[second.type_id as usize].clone(),
+            };
+            let mut e = located(self.bytes(), second.start, kind, Some(second.id));
+            e.entity = None;
+            e
+        };
+        if max_id <= (count as u64) * 4 + 1024 {
+            let mut table = vec![NO_RECORD; max_id as usize + 1];
+            for (i, r) in self.records.iter().enumerate() {
+                let slot = &mut table[r.id as usize];
+                if *slot != NO_RECORD {
+                    return Err(duplicate(&self.records[*slot as usize], r));
+                }
+                *slot = i as u32;
+            }
+            self.lookup = IdLookup::Dense(table);
+        } else {
+            let mut sorted: Vec<(u64, u32)> = self
+                .records
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (r.id, i as u32))
+                .collect();
+            sorted.sort_unstable();
+            if let Some(w) = sorted.windows(2).find(|w| w[0].0 == w[1].0) {
+                let (a, b) = (
+                    &self.records[w[0].1 as usize],
+                    &self.records[w[1].1 as usize],
+                );
+                let (first, second) = if a.start < b.start { (a, b) } else { (b, a) };
+                return Err(duplicate(first, second));
+            }
+            self.lookup = IdLookup::Sorted(sorted);
+        }
+        Ok(())
+    }
+
+    pub fn bytes(&self) -> &[u8] {
+        self.source.bytes()
+    }
+
+    pub fn len(&self) -> usize {
+        self.records.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.records.is_empty()
+    }
+
+    pub fn records(&self) -> &[Record] {
+        &self.records
+    }
+
+    pub fn record(&self, id: u64) -> Option<&Record> {
+        let index = match &self.lookup {
+            IdLookup::Dense(table) => *table.get(usize::try_from(id).ok()?)?,
+            IdLookup::Sorted(sorted) => sorted
+                .binary_search_by_key(&id, |e| e.0)
+                .ok()
+                .map(|i| sorted[i].1)?,
+        };
+        (index != NO_RECORD).then(|| &self.records[index as usize])
+    }
+
+    pub fn type_name(&self, type_id: TypeId) -> &str {
+        &self.type_names[type_id as usize]
+    }
+
+    pub fn type_id(&self, upper_name: &str) -> Option<TypeId> {
+        self.type_names
+            .iter()
+            .position(|n| n == upper_name)
+            .map(|i| i as TypeId)
+    }
+
+    /// Records of one type (upper-case name), in file order.
+    pub fn of_type(&self, upper_name: &str) -> impl Iterator<Item = &Record> + '_ {
+        let ids: &[u32] = self
+            .type_id(upper_name)
+            .map(|t| self.by_type[t as usize].as_slice())
+            .unwrap_or(&[]);
+        ids.iter().map(move |&i| &self.records[i as usize])
+    }
+
+    /// Number of instances of each type name, sorted by name.
+    pub fn type_counts(&self) -> Vec<(&str, usize)> {
+        let mut counts: Vec<(&str, usize)> = self
+            .type_names
+            .iter()
+            .zip(&self.by_type)
+            .map(|(n, v)| (n.as_str(), v.len()))
+            .collect();
+        counts.sort();
+        counts
+    }
+
+    /// Decodes the parameters of one record.
+    pub fn decode(&self, record: &Record) -> Result<Entity<'_>, StepError> {
+        let (start, end) = record.params;
+        let text = &self.bytes()[start..end];
+        match params::decode_list(text, self.max_depth) {
+            Ok(params) => Ok(Entity {
+                id: record.id,
+                type_name: self.type_name(record.type_id),
+                params,
+            }),
+            Err((at, kind)) => Err(located(self.bytes(), start + at, kind, Some(record.id))),
+        }
+    }
+
+    /// Decodes the entity `#id`; `None` when no such id is defined.
+    pub fn entity(&self, id: u64) -> Option<Result<Entity<'_>, StepError>> {
+        self.record(id).map(|r| self.decode(r))
+    }
+
+    /// 1-based line and column of a byte offset (CR, LF and CRLF line ends).
+    pub fn line_col(&self, offset: usize) -> (usize, usize) {
+        line_col(self.bytes(), offset)
+    }
+}
+
+fn line_col(bytes: &[u8], offset: usize) -> (usize, usize) {
+    let head = &bytes[..offset.min(bytes.len())];
+    let lf = memchr::memchr_iter(b'\n', head).count();
+    let lone_cr = memchr::memchr_iter(b'\r', head)
+        .filter(|&i| head.get(i + 1) != Some(&b'\n'))
+        .count();
+    let line_start = memchr::memrchr2(b'\n', b'\r', head).map_or(0, |i| i + 1);
+    (lf + lone_cr + 1, offset.saturating_sub(line_start) + 1)
+}
+
+fn located(bytes: &[u8], offset: usize, kind: StepErrorKind, entity: Option<u64>) -> StepError {
+    let (line, column) = line_col(bytes, offset);
+    StepError {
+        kind,
+        line,
+        column,
+        entity,
+    }
+}
+
+struct RawIndex {
+    records: Vec<Record>,
+    type_names: Vec<String>,
+}
+
+type ScanError = (usize, StepErrorKind, Option<u64>);
+
+/// Walks the file once: header, then every DATA section.
+struct Scanner<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    max_depth: usize,
+    types: FxHashMap<&'a [u8], TypeId>,
+    index: RawIndex,
+}
+
+impl<'a> Scanner<'a> {
+    fn new(bytes: &'a [u8], max_depth: usize) -> Self {
+        Scanner {
+            bytes,
+            pos: 0,
+            max_depth,
+            types: FxHashMap::default(),
+            // Instances take 40+ bytes in practice; reserving avoids regrowth copies.
+            index: RawIndex {
+                records: Vec::with_capacity(bytes.len() / 48),
+                type_names: Vec::new(),
+            },
+        }
+    }
+
+    fn skip(&mut self) {
+        let rest = skip_ws(&self.bytes[self.pos..]);
+        self.pos = self.bytes.len() - rest.len();
+    }
+
+    fn rest(&self) -> &'a [u8] {
+        &self.bytes[self.pos..]
+    }
+
+    /// Consumes `word` followed by optional white space and `;`.
+    fn keyword_statement(&mut self, word: &[u8]) -> bool {
+        let save = self.pos;
+        self.skip();
+        if self.rest().starts_with(word) {
+            self.pos += word.len();
+            self.skip();
+            if self.rest().first() == Some(&b';') {
+                self.pos += 1;
+                return true;
+            }
+        }
+        self.pos = save;
+        false
+    }
+
+    fn scan(mut self) -> Result<(Header, RawIndex), ScanError> {
+        // A UTF-8 byte order mark is tolerated.
+        if self.bytes.starts_with(b"\xEF\xBB\xBF") {
+            self.pos = 3;
+        }
+        if !self.keyword_statement(b"ISO-10303-21") {
+            self.skip();
+            return Err((self.pos, StepErrorKind::NotStep, None));
+        }
+        if !self.keyword_statement(b"HEADER") {
+            self.skip();
+            return Err((self.pos, StepErrorKind::MissingHeader, None));
+        }
+        let header = self.scan_header()?;
+        let mut sections = 0;
+        loop {
+            self.skip();
+            if self.rest().is_empty() {
+                if sections == 0 {
+                    return Err((self.pos, StepErrorKind::MissingData, None));
+                }
+                break;
+            }
+            if self.keyword_statement(b"END-ISO-10303-21") {
+                break;
+            }
+            if !self.data_section_start() {
+                let kind = if sections == 0 {
+                    StepErrorKind::MissingData
+                } else {
+                    StepErrorKind::Syntax(format!(
+                        "expected DATA; or END-ISO-10303-21; at `{}`",
+                        params::snippet(self.rest())
+                    ))
+                };
+                return Err((self.pos, kind, None));
+            }
+            sections += 1;
+            self.scan_data()?;
+        }
+        Ok((header, self.index))
+    }
+
+    fn scan_header(&mut self) -> Result<Header, ScanError> {
+        let mut header = Header::default();
+        let mut seen_schema = false;
+        loop {
+            self.skip();
+            if self.keyword_statement(b"ENDSEC") {
+                break;
+            }
+            let start = self.pos;
+            let (after_name, name) = match params::keyword(self.rest()) {
+                Ok(v) => v,
+                Err(_) if self.rest().is_empty() => {
+                    return Err((
+                        start,
+                        StepErrorKind::Truncated {
+                            inside: "the HEADER section".into(),
+                        },
+                        None,
+                    ));
+                }
+                Err(_) => {
+                    let msg = format!(
+                        "expected a header entity or ENDSEC; at `{}`",
+                        params::snippet(self.rest())
+                    );
+                    return Err((start, StepErrorKind::Syntax(msg), None));
+                }
+            };
+            let name = name.to_ascii_uppercase();
+            if name == "DATA" {
+                return Err((
+                    start,
+                    StepErrorKind::Syntax("the HEADER section has no ENDSEC;".into()),
+                    None,
+                ));
+            }
+            let list_start = self.bytes.len() - skip_ws(after_name).len();
+            let end = self.statement_end(list_start, &name, None)?;
+            let params = params::decode_list(&self.bytes[list_start..end], self.max_depth)
+                .map_err(|(at, kind)| (list_start + at, kind, None))?;
+            seen_schema |= name == "FILE_SCHEMA";
+            header.absorb(&name, &params);
+            self.pos = end + 1;
+        }
+        if !seen_schema {
+            return Err((
+                self.pos,
+                StepErrorKind::MissingHeaderEntity("FILE_SCHEMA"),
+                None,
+            ));
+        }
+        Ok(header)
+    }
+
+    /// `DATA;` or the edition-3 form `DATA(...);`.
+    fn data_section_start(&mut self) -> bool {
+        let save = self.pos;
+        if self.rest().starts_with(b"DATA") {
+            self.pos += 4;
+            self.skip();
+            if self.rest().first() == Some(&b'(') {
+                if let Ok(end) = self.statement_end(self.pos, "DATA", None) {
+                    self.pos = end + 1;
+                    return true;
+                }
+            } else if self.rest().first() == Some(&b';') {
+                self.pos += 1;
+                return true;
+            }
+        }
+        self.pos = save;
+        false
+    }
+
+    fn scan_data(&mut self) -> Result<(), ScanError> {
+        loop {
+            self.skip();
+            if self.keyword_statement(b"ENDSEC") {
+                return Ok(());
+            }
+            let start = self.pos;
+            let rest = self.rest();
+            if rest.is_empty() {
+                return Err((
+                    start,
+                    StepErrorKind::Truncated {
+                        inside: "the DATA section".into(),
+                    },
+                    None,
+                ));
+            }
+            if rest[0] != b'#' {
+                let msg = format!("expected `#id=` or ENDSEC; at `{}`", params::snippet(rest));
+                return Err((start, StepErrorKind::Syntax(msg), None));
+            }
+            let digits = rest[1..].iter().take_while(|c| c.is_ascii_digit()).count();
+            let id = std::str::from_utf8(&rest[1..1 + digits])
+                .ok()
+                .and_then(|d| d.parse::<u64>().ok());
+            let Some(id) = id else {
+                let msg = format!("bad entity id at `{}`", params::snippet(rest));
+                return Err((start, StepErrorKind::Syntax(msg), None));
+            };
+            self.pos += 1 + digits;
+            self.skip();
+            if self.rest().first() != Some(&b'=') {
+                let msg = format!("expected `=` after #{id}");
+                return Err((self.pos, StepErrorKind::Syntax(msg), Some(id)));
+            }
+            self.pos += 1;
+            self.skip();
+            let type_id = if self.rest().first() == Some(&b'(') {
+                // Complex instance `#id=(A(...)B(...));`: indexed under an empty type name.
+                self.intern(b"")
+            } else {
+                match params::keyword(self.rest()) {
+                    Ok((after, name)) => {
+                        let type_id = self.intern(name.as_bytes());
+                        self.pos = self.bytes.len() - skip_ws(after).len();
+                        type_id
+                    }
+                    Err(_) if self.rest().is_empty() => {
+                        let inside = format!("entity #{id}");
+                        return Err((start, StepErrorKind::Truncated { inside }, Some(id)));
+                    }
+                    Err(_) => {
+                        let msg = format!(
+                            "expected an entity type name at `{}`",
+                            params::snippet(self.rest())
+                        );
+                        return Err((self.pos, StepErrorKind::Syntax(msg), Some(id)));
+                    }
+                }
+            };
+            if self.rest().first() != Some(&b'(') {
+                let kind = if self.rest().is_empty() {
+                    StepErrorKind::Truncated {
+                        inside: format!("entity #{id}"),
+                    }
+                } else {
+                    StepErrorKind::Syntax(format!("expected `(` after the type name of #{id}"))
+                };
+                return Err((self.pos, kind, Some(id)));
+            }
+            let list_start = self.pos;
+            let end = self.statement_end(list_start, "", Some((id, start)))?;
+            let close = self.bytes[list_start..end].trim_ascii_end();
+            if close.last() != Some(&b')') {
+                let msg = format!("the parameter list of #{id} is not closed before `;`");
+                return Err((end, StepErrorKind::Syntax(msg), Some(id)));
+            }
+            self.index.records.push(Record {
+                id,
+                type_id,
+                start,
+                params: (list_start, list_start + close.len()),
+            });
+            self.pos = end + 1;
+        }
+    }
+
+    fn intern(&mut self, name: &'a [u8]) -> TypeId {
+        if let Some(&t) = self.types.get(name) {
+            return t;
+        }
+        let t = self.index.type_names.len() as TypeId;
+        self.index
+            .type_names
+            .push(String::from_utf8_lossy(name).to_ascii_uppercase());
+        self.types.insert(name, t);
+        t
+    }
+
+    /// Offset of the `;` ending the statement that starts at `from`,
+    /// skipping strings and comments.
+    fn statement_end(
+        &self,
+        from: usize,
+        what: &str,
+        entity: Option<(u64, usize)>,
+    ) -> Result<usize, ScanError> {
+        let bytes = self.bytes;
+        let mut at = from;
+        let truncated = || {
+            let (inside, start, id) = match entity {
+                Some((id, start)) => (format!("entity #{id}"), start, Some(id)),
+                None => (format!("header entity {what}"), from, None),
+            };
+            (start, StepErrorKind::Truncated { inside }, id)
+        };
+        loop {
+            let Some(p) = memchr::memchr3(b';', b'\'', b'/', &bytes[at..]) else {
+                return Err(truncated());
+            };
+            let i = at + p;
+            match bytes[i] {
+                b';' => return Ok(i),
+                b'\'' => match super::strings::string_end(&bytes[i + 1..]) {
+                    Some(end) => at = i + 1 + end + 1,
+                    None => return Err(truncated()),
+                },
+                _ => {
+                    if bytes.get(i + 1) == Some(&b'*') {
+                        let Some(q) = memchr::memmem::find(&bytes[i + 2..], b"*/") else {
+                            return Err(truncated());
+                        };
+                        at = i + 2 + q + 2;
+                    } else {
+                        at = i + 1;
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str) -> Result<StepFile, StepError> {
+        StepFile::from_bytes(text.as_bytes().to_vec(), &ReadOptions::default())
+    }
+
+    const GOOD: &str = "ISO-10303-21;\nHEADER;\n/* c */FILE_DESCRIPTION(('d'),'2;1');\nFILE_NAME('f','t',('a'),('o'),'p','Tool X','');\nFILE_SCHEMA(('IFC4'));\nENDSEC;\nDATA;\n#1=IFCCARTESIANPOINT((0.,1.,2.));\n#2 = IFCDIRECTION ( (1.,0.,0.) ) ;\n#10=IFCLABEL('a;b''c/*');\nENDSEC;\nEND-ISO-10303-21;\n";
+
+    #[test]
+    fn reads_header_and_index() {
+        let f = read(GOOD).unwrap();
+        assert_eq!(f.header.schemas, vec!["IFC4"]);
+        assert_eq!(f.header.originating_system, "Tool X");
+        assert_eq!(f.len(), 3);
+        let e = f.entity(2).unwrap().unwrap();
+        assert_eq!(e.type_name, "IFCDIRECTION");
+        let e = f.entity(10).unwrap().unwrap();
+        assert_eq!(e.get(0).text().unwrap().0, "a;b'c/*");
+        assert!(f.entity(3).is_none());
+        assert_eq!(f.of_type("IFCDIRECTION").count(), 1);
+    }
+
+    #[test]
+    fn cr_only_line_ends() {
+        let f = read(&GOOD.replace('\n', "\r")).unwrap();
+        let r = f.record(2).unwrap();
+        assert_eq!(f.line_col(r.start).0, 9);
+    }
+
+    #[test]
+    fn errors_name_lines() {
+        let e = read("HEADER;").unwrap_err();
+        assert_eq!(e.kind, StepErrorKind::NotStep);
+        let e = read("ISO-10303-21;\nDATA;\nENDSEC;").unwrap_err();
+        assert_eq!((e.kind, e.line), (StepErrorKind::MissingHeader, 2));
+        let cut = &GOOD[..GOOD.find("#2").unwrap() + 12];
+        let e = read(cut).unwrap_err();
+        assert!(matches!(e.kind, StepErrorKind::Truncated { .. }), "{e}");
+        assert_eq!(e.line, 9);
+        let dup = GOOD.replace("#10=", "#1=");
+        let e = read(&dup).unwrap_err();
+        assert!(
+            matches!(
+                e.kind,
+                StepErrorKind::DuplicateId {
+                    id: 1,
+                    first_line: 8,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert_eq!(e.line, 10);
+    }
+
+    #[test]
+    fn sparse_ids_use_sorted_lookup() {
+        let text = GOOD.replace("#10=", "#9000000000=");
+        let f = read(&text).unwrap();
+        assert!(f.entity(9_000_000_000).is_some());
+        assert!(f.entity(10).is_none());
+    }
+
+    #[test]
+    fn size_limit() {
+        let options = ReadOptions {
+            max_bytes: 10,
+            ..ReadOptions::default()
+        };
+        let e = StepFile::from_bytes(GOOD.as_bytes().to_vec(), &options).unwrap_err();
+        assert!(matches!(e.kind, StepErrorKind::TooLarge { .. }));
+    }
+}
