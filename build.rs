@@ -84,13 +84,41 @@ fn main() {
         // The built-in rule base is one program over all of rules/*.dl; the
         // test and bench programs are one program per file.
         let units: Vec<(String, Vec<PathBuf>)> = if dir == "rules" {
-            if files.is_empty() { Vec::new() } else { vec![(dir.to_string(), files)] }
+            if files.is_empty() {
+                Vec::new()
+            } else {
+                vec![(dir.to_string(), files)]
+            }
         } else {
             files
                 .into_iter()
-                .map(|f| (format!("{dir}/{}", f.file_name().unwrap().to_string_lossy()), vec![f]))
+                .map(|f| {
+                    (
+                        format!("{dir}/{}", f.file_name().unwrap().to_string_lossy()),
+                        vec![f],
+                    )
+                })
                 .collect()
         };
+        if dir == "rules" {
+            // The rule text is embedded too: the interpreter (provenance, `why`)
+            // runs the same rules without the source tree.
+            let _ = writeln!(
+                out,
+                "/// The built-in rule base: (file name, text).\npub static BUILTIN_RULES: &[(&str, &str)] = &["
+            );
+            for (_, files) in &units {
+                for f in files {
+                    let name = format!("rules/{}", f.file_name().unwrap().to_string_lossy());
+                    let _ = writeln!(
+                        out,
+                        "    ({name:?}, include_str!({:?})),",
+                        f.display().to_string()
+                    );
+                }
+            }
+            out.push_str("];\n");
+        }
         for (rel, files) in units {
             let program = match front::load_files(&files, SIGS) {
                 Ok(p) => p,

@@ -6,6 +6,7 @@
 //! See `docs/ARCHITECTURE.md` for the codemap.
 
 pub mod cell;
+pub mod frame;
 pub mod geom;
 pub mod ifc;
 pub mod logic;

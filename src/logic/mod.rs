@@ -33,6 +33,11 @@ impl Program {
         front::load_files(&paths, &functors::signatures())
     }
 
+    /// Parse and check several named texts as one program.
+    pub fn parse_sources(sources: &[(&str, &str)]) -> Result<Program, Diagnostics> {
+        front::load_sources(sources, &functors::signatures())
+    }
+
     /// Parse and check program text; `name` is used in error messages.
     pub fn parse_str(name: &str, text: &str) -> Result<Program, Diagnostics> {
         front::load_str(name, text, &functors::signatures())

@@ -32,3 +32,16 @@ pub fn load_str(name: &str, text: &str, functors: &[FunctorSig]) -> Result<Progr
     loader.load_text(name, text, Path::new("."))?;
     loader.finish()
 }
+
+/// Parse and check several named texts as one program (e.g. rule files
+/// embedded in the binary); names appear in messages as file names.
+pub fn load_sources(
+    sources: &[(&str, &str)],
+    functors: &[FunctorSig],
+) -> Result<Program, Diagnostics> {
+    let mut loader = check::Loader::new(functors);
+    for (name, text) in sources {
+        loader.load_text(name, text, Path::new("."))?;
+    }
+    loader.finish()
+}

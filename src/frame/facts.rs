@@ -1,0 +1,212 @@
+//! IFC model → input facts of the rule base (`rules/facts.dl`). Every tuple
+//! keeps its origin: the IFC entity it was read from.
+
+use crate::geom::{ContactOptions, OrientedBox, contacts};
+use crate::ifc::Model;
+use crate::logic::compiled::Relations;
+use crate::logic::{Engine, LogicError, OBox, Origin, Value, Vec3};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Density used when the model names no material we know, kg/m³
+/// (spruce-pine-fir, the study's lumber, at about 12 % moisture).
+pub const DEFAULT_DENSITY: f64 = 450.0;
+
+/// Densities of common framing species, kg/m³ (typical values at about 12 %
+/// moisture); matched case-insensitively against the material name.
+const SPECIES_DENSITY: &[(&str, f64)] = &[
+    ("spruce-pine-fir", 450.0),
+    ("spf", 450.0),
+    ("southern pine", 550.0),
+    ("southern yellow pine", 550.0),
+    ("douglas fir", 530.0),
+    ("douglas-fir", 530.0),
+    ("hem-fir", 460.0),
+    ("hem fir", 460.0),
+    ("spruce", 450.0),
+    ("fichte", 450.0),
+    ("kiefer", 520.0),
+    ("pine", 520.0),
+    ("larch", 590.0),
+    ("lvl", 600.0),
+    ("glulam", 480.0),
+];
+
+/// The density for a material name and whether it was a default.
+pub fn density_of(material: Option<&str>) -> (f64, bool) {
+    let name = material.unwrap_or("").to_ascii_lowercase();
+    SPECIES_DENSITY
+        .iter()
+        .find(|(key, _)| name.contains(key))
+        .map_or((DEFAULT_DENSITY, true), |(_, d)| (*d, false))
+}
+
+/// Input tuples by relation, each with its origin.
+#[derive(Debug, Default, Clone)]
+pub struct Facts {
+    pub tuples: BTreeMap<&'static str, Vec<(Vec<Value>, Origin)>>,
+}
+
+impl Facts {
+    pub fn add(&mut self, relation: &'static str, tuple: Vec<Value>, origin: Origin) {
+        self.tuples
+            .entry(relation)
+            .or_default()
+            .push((tuple, origin));
+    }
+
+    /// The tuples without origins, sorted, as the compiled engine takes them.
+    pub fn relations(&self) -> Relations {
+        self.tuples
+            .iter()
+            .map(|(name, tuples)| {
+                let mut v: Vec<Vec<Value>> = tuples.iter().map(|(t, _)| t.clone()).collect();
+                v.sort();
+                v.dedup();
+                (name.to_string(), v)
+            })
+            .collect()
+    }
+
+    /// Inserts every tuple into an interpreter (relations the program does not declare are skipped).
+    pub fn insert_into(&self, engine: &mut Engine) -> Result<(), LogicError> {
+        for (name, tuples) in &self.tuples {
+            if !engine.program().relations.iter().any(|r| r.name == *name) {
+                continue;
+            }
+            for (tuple, origin) in tuples {
+                engine.insert(name, tuple.clone(), origin.clone())?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn sym(s: &str) -> Value {
+    Value::sym(s)
+}
+
+fn vec3(v: &nalgebra::Vector3<f64>) -> Value {
+    Value::Vec3(Vec3(*v))
+}
+
+/// The box as the rule language sees it: pose axes x, y, z = length, width, thickness.
+pub fn obox_value(b: &OrientedBox) -> Value {
+    let m = nalgebra::Matrix3::from_columns(&b.axes);
+    let rotation = nalgebra::UnitQuaternion::from_rotation_matrix(
+        &nalgebra::Rotation3::from_matrix_unchecked(m),
+    );
+    let pose =
+        nalgebra::Isometry3::from_parts(nalgebra::Translation3::from(b.centre.coords), rotation);
+    Value::Box(Arc::new(OBox {
+        pose,
+        half: nalgebra::Vector3::from(b.half),
+    }))
+}
+
+/// The facts of a model: pieces, their boxes, groups, containers, materials and contacts.
+pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
+    let mut facts = Facts::default();
+    for (index, p) in model.pieces().iter().enumerate() {
+        let origin = Origin::Entity(p.entity);
+        let id = sym(&p.id);
+        let text = |s: &Option<String>| sym(s.as_deref().unwrap_or(""));
+        facts.add(
+            "piece",
+            vec![
+                id.clone(),
+                Value::Number(p.entity as i64),
+                sym(&p.ifc_type),
+                text(&p.name),
+            ],
+            origin.clone(),
+        );
+        facts.add(
+            "piece_box",
+            vec![id.clone(), obox_value(&p.obox)],
+            Origin::Entity(p.item),
+        );
+        facts.add(
+            "piece_size",
+            vec![
+                id.clone(),
+                Value::float(p.obox.length()),
+                Value::float(p.obox.width()),
+                Value::float(p.obox.thickness()),
+            ],
+            Origin::Entity(p.item),
+        );
+        facts.add(
+            "piece_index",
+            vec![id.clone(), Value::Number(index as i64)],
+            origin.clone(),
+        );
+        facts.add(
+            "piece_type",
+            vec![id.clone(), text(&p.predefined_type), text(&p.object_type)],
+            origin.clone(),
+        );
+        if let Some(group) = p.parent.and_then(|g| model.groups.get(&g)) {
+            facts.add(
+                "piece_group",
+                vec![
+                    id.clone(),
+                    sym(&group.global_id),
+                    sym(&group.ifc_type),
+                    text(&group.name),
+                ],
+                Origin::Entity(group.entity),
+            );
+        }
+        let container = p.container.and_then(|c| model.groups.get(&c));
+        facts.add(
+            "piece_container",
+            vec![
+                id.clone(),
+                sym(container.map_or("", |c| c.global_id.as_str())),
+            ],
+            container.map_or(origin.clone(), |c| Origin::Entity(c.entity)),
+        );
+        let (density, _) = density_of(p.material.as_deref());
+        facts.add(
+            "piece_material",
+            vec![id.clone(), text(&p.material), Value::float(density)],
+            origin,
+        );
+    }
+    let boxes: Vec<OrientedBox> = model.pieces().iter().map(|p| p.obox).collect();
+    for c in contacts(&boxes, contact_options) {
+        let (a, b) = (&model.pieces()[c.a], &model.pieces()[c.b]);
+        let origin = Origin::Entity(a.entity);
+        let kind = sym(c.kind.name());
+        facts.add(
+            "contact",
+            vec![
+                sym(&a.id),
+                sym(&b.id),
+                kind.clone(),
+                sym(c.face_a.name()),
+                sym(c.face_b.name()),
+                Value::float(c.gap),
+                vec3(&c.normal),
+                vec3(&c.centre.coords),
+            ],
+            origin.clone(),
+        );
+        facts.add(
+            "contact",
+            vec![
+                sym(&b.id),
+                sym(&a.id),
+                kind,
+                sym(c.face_b.name()),
+                sym(c.face_a.name()),
+                Value::float(c.gap),
+                vec3(&-c.normal),
+                vec3(&c.centre.coords),
+            ],
+            Origin::Entity(b.entity),
+        );
+    }
+    facts
+}

@@ -1,0 +1,121 @@
+//! Frame reasoning: the built-in rule base (`rules/*.dl`) over the facts of a
+//! model. The compiled (ascent) engine is the normal path; the interpreter
+//! runs the same rules for `--rules-dir`, user rules and provenance.
+
+pub mod facts;
+
+use crate::ifc::Model;
+use crate::logic::compiled::{self, Relations};
+use crate::logic::{Diagnostics, Engine, LogicError, Options, Program, Value};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+pub use facts::{Facts, model_facts};
+
+#[derive(Debug, thiserror::Error)]
+pub enum FrameError {
+    #[error("{0}")]
+    Rules(#[from] Diagnostics),
+    #[error("{0}")]
+    Logic(#[from] LogicError),
+    #[error("the compiled rule base failed: {0}")]
+    Compiled(String),
+    #[error("{}: cannot read the rules directory: {message}", path.display())]
+    RulesDir { path: PathBuf, message: String },
+}
+
+/// Which engine evaluates the rule base.
+#[derive(Debug, Clone, Default)]
+pub enum RuleEngine {
+    /// The built-in rules compiled with ascent (fast; no provenance).
+    #[default]
+    Compiled,
+    /// The built-in rules on the interpreter.
+    Interpreted,
+    /// Every `.dl` file of a directory on the interpreter, replacing the built-in rules.
+    Directory(PathBuf),
+}
+
+/// The evaluated rule base: every relation by name (tuples sorted).
+pub struct Reasoned {
+    pub relations: Relations,
+    /// The interpreter that ran, when one did (for explanations).
+    pub engine: Option<Engine>,
+}
+
+impl Reasoned {
+    pub fn get(&self, relation: &str) -> &[Vec<Value>] {
+        self.relations.get(relation).map_or(&[], Vec::as_slice)
+    }
+}
+
+/// The built-in rule base as a checked program (for the interpreter).
+pub fn builtin_program() -> Result<Program, Diagnostics> {
+    Program::parse_sources(compiled::BUILTIN_RULES)
+}
+
+/// Every `.dl` file of `dir`, sorted, as one program.
+pub fn directory_program(dir: &Path) -> Result<Program, FrameError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| FrameError::RulesDir {
+        path: dir.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "dl"))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(FrameError::RulesDir {
+            path: dir.to_path_buf(),
+            message: "it holds no .dl files".into(),
+        });
+    }
+    Ok(Program::parse_files(&files)?)
+}
+
+/// Runs the rule base over the facts.
+pub fn reason(
+    facts: &Facts,
+    engine: &RuleEngine,
+    provenance: bool,
+) -> Result<Reasoned, FrameError> {
+    let program = match engine {
+        RuleEngine::Compiled if !provenance => {
+            let run = compiled::program("rules")
+                .ok_or_else(|| FrameError::Compiled("no compiled rule base".into()))?;
+            let relations = run(&facts.relations()).map_err(FrameError::Compiled)?;
+            return Ok(Reasoned {
+                relations,
+                engine: None,
+            });
+        }
+        RuleEngine::Compiled | RuleEngine::Interpreted => builtin_program()?,
+        RuleEngine::Directory(dir) => directory_program(dir)?,
+    };
+    let program = Arc::new(program);
+    let mut interpreter = Engine::new(
+        program.clone(),
+        Options {
+            provenance,
+            ..Options::default()
+        },
+    );
+    facts.insert_into(&mut interpreter)?;
+    interpreter.run()?;
+    let relations = program
+        .relations
+        .iter()
+        .map(|r| interpreter.relation(&r.name).map(|t| (r.name.clone(), t)))
+        .collect::<Result<Relations, LogicError>>()?;
+    Ok(Reasoned {
+        relations,
+        engine: Some(interpreter),
+    })
+}
+
+/// Facts of a model with default options, reasoned with the compiled rules.
+pub fn reason_model(model: &Model) -> Result<Reasoned, FrameError> {
+    let facts = model_facts(model, &crate::geom::ContactOptions::default());
+    reason(&facts, &RuleEngine::Compiled, false)
+}
