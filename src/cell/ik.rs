@@ -1,0 +1,312 @@
+//! Inverse kinematics for a `Robot`: closed form (OPW) when the robot has OPW parameters, damped
+//! least squares otherwise. Every returned solution is checked with the URDF's FK; failures are
+//! data with the numbers that explain them.
+
+use super::opw::wrap;
+use super::robot::Robot;
+use nalgebra::Isometry3;
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// Why IK gave no solution. Serialises as `{"kind": "out_of_reach", "distance": …, …}`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum IkFailure {
+    /// The wrist centre (OPW) or the tip (numeric IK) is farther from the shoulder than the arm
+    /// reaches, or closer than its inner limit. Distances in m.
+    OutOfReach {
+        distance: f64,
+        reach: f64,
+        min_reach: f64,
+    },
+    /// Every exact solution breaks a joint limit; the one closest to its limits is reported:
+    /// `value` of `joint` lies `excess` beyond `limit` (rad or m).
+    JointLimit {
+        joint: String,
+        value: f64,
+        limit: f64,
+        excess: f64,
+    },
+    /// Every solution within limits has the wrist closer to singular than asked for:
+    /// `margin` is the best wrist angle found, `required` the asked minimum (rad).
+    WristSingularity { margin: f64, required: f64 },
+    /// No collision-free solution (filled by the executor): the colliding pair of bodies.
+    AllSolutionsCollide { pair: [String; 2] },
+    /// The numeric solver could not get the tip onto the pose: best residual left (m, rad).
+    NoExactSolution {
+        position_error: f64,
+        rotation_error: f64,
+    },
+    /// The pose has NaN or infinite numbers.
+    InvalidPose,
+}
+
+impl std::fmt::Display for IkFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            IkFailure::OutOfReach {
+                distance,
+                reach,
+                min_reach,
+            } => write!(
+                f,
+                "out of reach: {distance:.4} m from the shoulder, the arm reaches {min_reach:.4}..{reach:.4} m"
+            ),
+            IkFailure::JointLimit {
+                joint,
+                value,
+                limit,
+                excess,
+            } => write!(
+                f,
+                "joint limit: {joint} would be {value:.4}, {excess:.4} beyond its limit {limit:.4}"
+            ),
+            IkFailure::WristSingularity { margin, required } => write!(
+                f,
+                "wrist singularity: wrist angle {margin:.4} rad, at least {required:.4} rad needed"
+            ),
+            IkFailure::AllSolutionsCollide { pair } => {
+                write!(f, "every solution collides: {} with {}", pair[0], pair[1])
+            }
+            IkFailure::NoExactSolution {
+                position_error,
+                rotation_error,
+            } => write!(
+                f,
+                "no exact solution: best residual {position_error:.3e} m, {rotation_error:.3e} rad"
+            ),
+            IkFailure::InvalidPose => write!(f, "the pose is not finite"),
+        }
+    }
+}
+
+impl std::error::Error for IkFailure {}
+
+/// Tuning of `Robot::ik_with`.
+#[derive(Debug, Clone, Copy)]
+pub struct IkOptions {
+    /// A solution is accepted only if FK puts the tip within this distance (m) ...
+    pub position_tolerance: f64,
+    /// ... and this rotation angle (rad) of the target.
+    pub rotation_tolerance: f64,
+    /// Minimum wrist angle (rad, distance of θ5 from 0 and π); 0 accepts singular solutions
+    /// (the free wrist angle is then taken from the seed).
+    pub wrist_margin: f64,
+}
+
+impl Default for IkOptions {
+    fn default() -> Self {
+        IkOptions {
+            position_tolerance: 1e-6,
+            rotation_tolerance: 1e-6,
+            wrist_margin: 0.0,
+        }
+    }
+}
+
+impl Robot {
+    /// All joint solutions (within limits, closest to `seed` first) that put the TCP at `pose`.
+    /// `pose` is the TCP in `base_link`; `tcp` is the TCP in the tip frame (`tool0`).
+    pub fn ik(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64],
+    ) -> Result<Vec<Vec<f64>>, IkFailure> {
+        self.ik_with(pose, tcp, seed, &IkOptions::default())
+    }
+
+    /// `ik` with explicit tolerances and wrist margin.
+    pub fn ik_with(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64],
+        options: &IkOptions,
+    ) -> Result<Vec<Vec<f64>>, IkFailure> {
+        assert_eq!(seed.len(), self.dof(), "seed length");
+        let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
+        if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
+            return Err(IkFailure::InvalidPose);
+        }
+        let target = pose * tcp.inverse();
+        match &self.opw {
+            Some(_) => self.ik_closed_form(&target, seed, options),
+            None => self.ik_numeric(&target, seed, options),
+        }
+    }
+
+    /// 6-axis IK as fixed-size arrays (the executor's and the bench's form).
+    pub fn ik6(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64; 6],
+    ) -> Result<Vec<[f64; 6]>, IkFailure> {
+        let sols = self.ik(pose, tcp, seed)?;
+        Ok(sols
+            .into_iter()
+            .map(|s| std::array::from_fn(|i| s[i]))
+            .collect())
+    }
+
+    /// Whether FK of `q` puts the tip on `target` within the tolerances.
+    pub(crate) fn residual(&self, q: &[f64], target: &Isometry3<f64>) -> (f64, f64) {
+        let got = self.fk_tip(q);
+        (
+            (got.translation.vector - target.translation.vector).norm(),
+            got.rotation.angle_to(&target.rotation),
+        )
+    }
+
+    fn ik_closed_form(
+        &self,
+        target: &Isometry3<f64>,
+        seed: &[f64],
+        options: &IkOptions,
+    ) -> Result<Vec<Vec<f64>>, IkFailure> {
+        let opw = self.opw.as_ref().expect("closed form");
+        let raw = opw.solve(target, seed[3]);
+        if raw.candidates.is_empty() {
+            let (min_reach, reach) = opw.shoulder_reach();
+            let [front, back] = raw.shoulder_distance;
+            // Report the shoulder position that is nearer to being in range.
+            let miss = |d: f64| (d - reach).max(min_reach - d);
+            let distance = if miss(front) <= miss(back) {
+                front
+            } else {
+                back
+            };
+            return Err(IkFailure::OutOfReach {
+                distance,
+                reach,
+                min_reach,
+            });
+        }
+        let limits = self.limits();
+        let mut within: Vec<(Vec<f64>, f64)> = vec![];
+        let mut best_violation: Option<(f64, IkFailure)> = None;
+        let mut best_residual = (f64::INFINITY, f64::INFINITY);
+        for (cand, &t5) in raw.candidates.iter().zip(&raw.wrist_angles) {
+            let (dp, dr) = self.residual(cand, target);
+            if !(dp <= options.position_tolerance && dr <= options.rotation_tolerance) {
+                if dp + dr < best_residual.0 + best_residual.1 {
+                    best_residual = (dp, dr);
+                }
+                continue;
+            }
+            let wrist = t5.abs().min(PI - t5.abs());
+            let variants = self.limit_variants(cand, &limits);
+            if variants.is_empty() {
+                let failure = self.worst_limit(cand, &limits);
+                if let IkFailure::JointLimit { excess, .. } = failure
+                    && best_violation.as_ref().is_none_or(|(e, _)| excess < *e)
+                {
+                    best_violation = Some((excess, failure));
+                }
+            }
+            for v in variants {
+                within.push((v, wrist));
+            }
+        }
+        if within.is_empty() {
+            return Err(match best_violation {
+                Some((_, failure)) => failure,
+                None => IkFailure::NoExactSolution {
+                    position_error: best_residual.0,
+                    rotation_error: best_residual.1,
+                },
+            });
+        }
+        let best_wrist = within.iter().map(|(_, w)| *w).fold(0.0, f64::max);
+        within.retain(|(_, w)| *w >= options.wrist_margin);
+        if within.is_empty() {
+            return Err(IkFailure::WristSingularity {
+                margin: best_wrist,
+                required: options.wrist_margin,
+            });
+        }
+        let mut sols: Vec<Vec<f64>> = within.into_iter().map(|(q, _)| q).collect();
+        sort_by_distance(&mut sols, seed);
+        sols.dedup_by(|a, b| a.iter().zip(b.iter()).all(|(x, y)| (x - y).abs() < 1e-9));
+        Ok(sols)
+    }
+
+    /// Every copy of `q` shifted by whole turns on the revolute joints that fits the limits.
+    fn limit_variants(&self, q: &[f64], limits: &[(f64, f64)]) -> Vec<Vec<f64>> {
+        let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(q.len())];
+        for (i, (&v, &(lo, hi))) in q.iter().zip(limits).enumerate() {
+            let turns = self.joints[self.active[i]].kind != super::robot::JointKind::Prismatic;
+            let mut options: Vec<f64> = vec![];
+            if turns && hi - lo >= 1e-12 {
+                // Smallest k with v + 2πk ≥ lo, then every further turn up to hi.
+                let mut x = v + 2.0 * PI * ((lo - v) / (2.0 * PI)).ceil();
+                while x <= hi + 1e-12 {
+                    options.push(x.clamp(lo, hi));
+                    x += 2.0 * PI;
+                }
+            } else if v >= lo - 1e-12 && v <= hi + 1e-12 {
+                options.push(v.clamp(lo, hi));
+            }
+            if options.is_empty() {
+                return vec![];
+            }
+            let mut next = Vec::with_capacity(out.len() * options.len());
+            for prefix in &out {
+                for &o in &options {
+                    let mut p = prefix.clone();
+                    p.push(o);
+                    next.push(p);
+                }
+            }
+            out = next;
+        }
+        out
+    }
+
+    /// The limit violation of `q` that matters most (largest excess, whole turns allowed).
+    fn worst_limit(&self, q: &[f64], limits: &[(f64, f64)]) -> IkFailure {
+        let mut worst: Option<(f64, usize, f64, f64)> = None;
+        for (i, (&v, &(lo, hi))) in q.iter().zip(limits).enumerate() {
+            // The whole-turn copy of v nearest to the allowed range.
+            let nearest = if self.joints[self.active[i]].kind == super::robot::JointKind::Prismatic
+            {
+                v
+            } else {
+                let mid = (lo + hi) / 2.0;
+                mid + wrap(v - mid)
+            };
+            let (excess, limit) = if nearest < lo {
+                (lo - nearest, lo)
+            } else if nearest > hi {
+                (nearest - hi, hi)
+            } else {
+                (0.0, lo)
+            };
+            if excess > 0.0 && worst.is_none_or(|(e, ..)| excess > e) {
+                worst = Some((excess, i, nearest, limit));
+            }
+        }
+        let (excess, i, value, limit) = worst.unwrap_or((0.0, 0, q[0], limits[0].0));
+        IkFailure::JointLimit {
+            joint: self.joints[self.active[i]].name.clone(),
+            value,
+            limit,
+            excess,
+        }
+    }
+}
+
+/// Sort joint vectors by Euclidean distance to `seed` (ties: lexicographic, for determinism).
+pub(crate) fn sort_by_distance(sols: &mut [Vec<f64>], seed: &[f64]) {
+    let dist = |q: &Vec<f64>| -> f64 { q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum() };
+    sols.sort_by(|a, b| {
+        dist(a).total_cmp(&dist(b)).then_with(|| {
+            a.iter()
+                .zip(b.iter())
+                .fold(std::cmp::Ordering::Equal, |o, (x, y)| {
+                    o.then(x.total_cmp(y))
+                })
+        })
+    });
+}
