@@ -17,6 +17,33 @@ pub(crate) const ROBOTS: &[(&str, &str, &str, &str)] = &[
     ),
 ];
 
+pub(crate) const TOOLS: &[(&str, &str, &str)] = &[(
+    "study-gripper-nailer",
+    "robots/tools/study-gripper-nailer.toml",
+    include_str!("../../robots/tools/study-gripper-nailer.toml"),
+)];
+
+pub(crate) const CELLS: &[(&str, &str, &str)] = &[
+    (
+        "study-abb",
+        "robots/cells/study-abb.toml",
+        include_str!("../../robots/cells/study-abb.toml"),
+    ),
+    (
+        "study-kuka",
+        "robots/cells/study-kuka.toml",
+        include_str!("../../robots/cells/study-kuka.toml"),
+    ),
+];
+
 pub fn robot_names() -> Vec<&'static str> {
     ROBOTS.iter().map(|r| r.0).collect()
+}
+
+pub fn tool_names() -> Vec<&'static str> {
+    TOOLS.iter().map(|t| t.0).collect()
+}
+
+pub fn cell_names() -> Vec<&'static str> {
+    CELLS.iter().map(|c| c.0).collect()
 }

@@ -136,6 +136,21 @@ impl Robot {
         }
     }
 
+    /// How far (m) the wrist centre for this TCP pose is inside the arm's reach from the shoulder
+    /// (negative: out of reach). `None` for robots without a closed form.
+    pub fn reach_margin(&self, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) -> Option<f64> {
+        let opw = self.opw.as_ref()?;
+        let target = pose * tcp.inverse();
+        let [front, _] = opw.solve(&target, 0.0).shoulder_distance;
+        let (min_reach, reach) = opw.shoulder_reach();
+        Some((reach - front).min(front - min_reach))
+    }
+
+    /// Reach of the wrist centre from the shoulder (min, max) in m, for closed-form robots.
+    pub fn shoulder_reach(&self) -> Option<(f64, f64)> {
+        self.opw.as_ref().map(|o| o.shoulder_reach())
+    }
+
     /// 6-axis IK as fixed-size arrays (the executor's and the bench's form).
     pub fn ik6(
         &self,

@@ -9,19 +9,23 @@ mod builtin;
 mod dls;
 mod error;
 mod ik;
+mod layout;
 mod load;
 mod meta;
 mod opw;
 mod robot;
 mod shapes;
 mod toml_file;
+mod tool;
 
-pub use builtin::robot_names;
+pub use builtin::{cell_names, robot_names, tool_names};
 pub use error::CellError;
 pub use ik::{IkFailure, IkOptions};
+pub use layout::{Assembly, Cell, Conveyor, Floor, Orientation, Pick, ToolTable, TouchSensor};
 pub use meta::{OpwParams, RobotMeta};
 pub use robot::{Inertial, Joint, JointKind, Link, Robot};
 pub use shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};
+pub use tool::{Gripper, Tool, ToolPart};
 
 use nalgebra::Isometry3;
 

@@ -11,12 +11,37 @@ pub fn parse<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T, CellErro
             .span()
             .map(|span| line_col(text, span.start))
             .unwrap_or((1, 1));
+        let message = err.message().trim();
         CellError::Toml {
             path: path.to_path_buf(),
             line,
             column,
-            message: err.message().trim().to_string(),
+            message: match key_at(text, line) {
+                Some(key) => format!("key `{key}`: {message}"),
+                None => message.to_string(),
+            },
         }
+    })
+}
+
+/// The dotted key written on 1-based `line` (`section.key`), if that line is `key = value`.
+fn key_at(text: &str, line: usize) -> Option<String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let here = lines.get(line.checked_sub(1)?)?.trim();
+    let (key, _) = here.split_once('=')?;
+    let key = key.trim();
+    if key.is_empty() || key.starts_with('#') || key.starts_with('[') {
+        return None;
+    }
+    let section = lines[..line - 1]
+        .iter()
+        .rev()
+        .map(|l| l.trim())
+        .find(|l| l.starts_with('['))
+        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim().to_string());
+    Some(match section {
+        Some(s) if !s.is_empty() => format!("{s}.{key}"),
+        _ => key.to_string(),
     })
 }
 
