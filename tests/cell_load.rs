@@ -163,3 +163,37 @@ fn unknown_cell_name_lists_the_built_ins() {
         "{msg}"
     );
 }
+
+#[test]
+fn study_layout_reproduces_the_unreachable_top_plate() {
+    // An 8 ft (2.44 m) wall laid flat from assembly.offset_x: the middle of a stud is within
+    // reach, the top plate (2x4 on edge, grip TCP pointing down on its top face) is not — as in
+    // the study.
+    for name in ["study-abb", "study-kuka"] {
+        let cell = Cell::load(name).unwrap();
+        let grip = *cell.tool.tcp("grip").unwrap();
+        let down = |x: f64| {
+            nalgebra::Isometry3::from_parts(
+                nalgebra::Translation3::new(x, 0.0, 0.089),
+                nalgebra::UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.0),
+            )
+        };
+        let middle = cell.assembly.offset_x + 1.22;
+        let top = cell.assembly.offset_x + 2.44 - 0.019;
+        assert!(
+            cell.robot
+                .ik(&cell.to_robot(&down(middle)), &grip, &cell.robot.home())
+                .is_ok(),
+            "{name}"
+        );
+        match cell
+            .robot
+            .ik(&cell.to_robot(&down(top)), &grip, &cell.robot.home())
+        {
+            Err(framewright::cell::IkFailure::OutOfReach {
+                distance, reach, ..
+            }) => assert!(distance > reach),
+            other => panic!("{name}: top plate at x = {top}: {other:?}"),
+        }
+    }
+}

@@ -131,7 +131,11 @@ impl Robot {
         }
         let target = pose * tcp.inverse();
         match &self.opw {
-            Some(_) => self.ik_closed_form(&target, seed, options),
+            Some(_) => Ok(self
+                .ik_closed_form(&target, seed, options)?
+                .into_iter()
+                .map(|q| q.to_vec())
+                .collect()),
             None => self.ik_numeric(&target, seed, options),
         }
     }
@@ -158,11 +162,21 @@ impl Robot {
         tcp: &Isometry3<f64>,
         seed: &[f64; 6],
     ) -> Result<Vec<[f64; 6]>, IkFailure> {
-        let sols = self.ik(pose, tcp, seed)?;
-        Ok(sols
-            .into_iter()
-            .map(|s| std::array::from_fn(|i| s[i]))
-            .collect())
+        assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
+        let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
+        if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
+            return Err(IkFailure::InvalidPose);
+        }
+        let target = pose * tcp.inverse();
+        let options = IkOptions::default();
+        match &self.opw {
+            Some(_) => self.ik_closed_form(&target, seed, &options),
+            None => Ok(self
+                .ik_numeric(&target, seed, &options)?
+                .into_iter()
+                .map(|s| std::array::from_fn(|i| s[i]))
+                .collect()),
+        }
     }
 
     /// Whether FK of `q` puts the tip on `target` within the tolerances.
@@ -174,12 +188,13 @@ impl Robot {
         )
     }
 
+    /// Closed-form IK on fixed-size arrays (no allocation per candidate).
     fn ik_closed_form(
         &self,
         target: &Isometry3<f64>,
         seed: &[f64],
         options: &IkOptions,
-    ) -> Result<Vec<Vec<f64>>, IkFailure> {
+    ) -> Result<Vec<[f64; 6]>, IkFailure> {
         let opw = self.opw.as_ref().expect("closed form");
         let raw = opw.solve(target, seed[3]);
         if raw.candidates.is_empty() {
@@ -198,8 +213,11 @@ impl Robot {
                 min_reach,
             });
         }
-        let limits = self.limits();
-        let mut within: Vec<(Vec<f64>, f64)> = vec![];
+        let limits: [(f64, f64); 6] = std::array::from_fn(|i| {
+            let j = &self.joints[self.active[i]];
+            (j.lower, j.upper)
+        });
+        let mut within: Vec<([f64; 6], f64)> = Vec::with_capacity(32);
         let mut best_violation: Option<(f64, IkFailure)> = None;
         let mut best_residual = (f64::INFINITY, f64::INFINITY);
         for (cand, &t5) in raw.candidates.iter().zip(&raw.wrist_angles) {
@@ -211,17 +229,15 @@ impl Robot {
                 continue;
             }
             let wrist = t5.abs().min(PI - t5.abs());
-            let variants = self.limit_variants(cand, &limits);
-            if variants.is_empty() {
+            let before = within.len();
+            push_turn_variants(cand, &limits, wrist, &mut within);
+            if within.len() == before {
                 let failure = self.worst_limit(cand, &limits);
                 if let IkFailure::JointLimit { excess, .. } = failure
                     && best_violation.as_ref().is_none_or(|(e, _)| excess < *e)
                 {
                     best_violation = Some((excess, failure));
                 }
-            }
-            for v in variants {
-                within.push((v, wrist));
             }
         }
         if within.is_empty() {
@@ -241,42 +257,20 @@ impl Robot {
                 required: options.wrist_margin,
             });
         }
-        let mut sols: Vec<Vec<f64>> = within.into_iter().map(|(q, _)| q).collect();
-        sort_by_distance(&mut sols, seed);
-        sols.dedup_by(|a, b| a.iter().zip(b.iter()).all(|(x, y)| (x - y).abs() < 1e-9));
-        Ok(sols)
-    }
-
-    /// Every copy of `q` shifted by whole turns on the revolute joints that fits the limits.
-    fn limit_variants(&self, q: &[f64], limits: &[(f64, f64)]) -> Vec<Vec<f64>> {
-        let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(q.len())];
-        for (i, (&v, &(lo, hi))) in q.iter().zip(limits).enumerate() {
-            let turns = self.joints[self.active[i]].kind != super::robot::JointKind::Prismatic;
-            let mut options: Vec<f64> = vec![];
-            if turns && hi - lo >= 1e-12 {
-                // Smallest k with v + 2πk ≥ lo, then every further turn up to hi.
-                let mut x = v + 2.0 * PI * ((lo - v) / (2.0 * PI)).ceil();
-                while x <= hi + 1e-12 {
-                    options.push(x.clamp(lo, hi));
-                    x += 2.0 * PI;
-                }
-            } else if v >= lo - 1e-12 && v <= hi + 1e-12 {
-                options.push(v.clamp(lo, hi));
-            }
-            if options.is_empty() {
-                return vec![];
-            }
-            let mut next = Vec::with_capacity(out.len() * options.len());
-            for prefix in &out {
-                for &o in &options {
-                    let mut p = prefix.clone();
-                    p.push(o);
-                    next.push(p);
-                }
-            }
-            out = next;
-        }
-        out
+        // Sort by distance to the seed (computed once each), ties lexicographic; drop duplicates.
+        let dist = |q: &[f64; 6]| -> f64 { q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum() };
+        let mut keyed: Vec<(f64, [f64; 6])> = within.iter().map(|(q, _)| (dist(q), *q)).collect();
+        keyed.sort_by(|(da, a), (db, b)| {
+            da.total_cmp(db).then_with(|| {
+                a.iter()
+                    .zip(b)
+                    .fold(std::cmp::Ordering::Equal, |o, (x, y)| {
+                        o.then(x.total_cmp(y))
+                    })
+            })
+        });
+        keyed.dedup_by(|a, b| a.1.iter().zip(&b.1).all(|(x, y)| (x - y).abs() < 1e-9));
+        Ok(keyed.into_iter().map(|(_, q)| q).collect())
     }
 
     /// The limit violation of `q` that matters most (largest excess, whole turns allowed).
@@ -312,11 +306,60 @@ impl Robot {
     }
 }
 
+/// Push every copy of `q` shifted by whole turns that fits the limits (all joints revolute).
+fn push_turn_variants(
+    q: &[f64; 6],
+    limits: &[(f64, f64); 6],
+    wrist: f64,
+    out: &mut Vec<([f64; 6], f64)>,
+) {
+    // Per joint, up to 4 values (a range of up to 3 turns, e.g. ±400°, holds at most 3).
+    let mut options = [[0.0f64; 4]; 6];
+    let mut counts = [0usize; 6];
+    for i in 0..6 {
+        let (lo, hi) = limits[i];
+        if !(lo.is_finite() && hi.is_finite()) {
+            // Continuous joint: the wrapped value stands for all turns.
+            options[i][0] = q[i];
+            counts[i] = 1;
+            continue;
+        }
+        let mut x = q[i] + 2.0 * PI * ((lo - q[i]) / (2.0 * PI)).ceil();
+        while x <= hi + 1e-12 && counts[i] < 4 {
+            options[i][counts[i]] = x.clamp(lo, hi);
+            counts[i] += 1;
+            x += 2.0 * PI;
+        }
+        if counts[i] == 0 {
+            return;
+        }
+    }
+    let mut idx = [0usize; 6];
+    loop {
+        out.push((std::array::from_fn(|i| options[i][idx[i]]), wrist));
+        // Odometer over the option indices.
+        let mut k = 5;
+        loop {
+            idx[k] += 1;
+            if idx[k] < counts[k] {
+                break;
+            }
+            idx[k] = 0;
+            if k == 0 {
+                return;
+            }
+            k -= 1;
+        }
+    }
+}
+
 /// Sort joint vectors by Euclidean distance to `seed` (ties: lexicographic, for determinism).
-pub(crate) fn sort_by_distance(sols: &mut [Vec<f64>], seed: &[f64]) {
-    let dist = |q: &Vec<f64>| -> f64 { q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum() };
-    sols.sort_by(|a, b| {
-        dist(a).total_cmp(&dist(b)).then_with(|| {
+pub(crate) fn sort_by_distance(sols: &mut Vec<Vec<f64>>, seed: &[f64]) {
+    let dist = |q: &[f64]| -> f64 { q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum() };
+    // Distances computed once per solution, not per comparison.
+    let mut keyed: Vec<(f64, Vec<f64>)> = sols.drain(..).map(|q| (dist(&q), q)).collect();
+    keyed.sort_by(|(da, a), (db, b)| {
+        da.total_cmp(db).then_with(|| {
             a.iter()
                 .zip(b.iter())
                 .fold(std::cmp::Ordering::Equal, |o, (x, y)| {
@@ -324,4 +367,5 @@ pub(crate) fn sort_by_distance(sols: &mut [Vec<f64>], seed: &[f64]) {
                 })
         })
     });
+    sols.extend(keyed.into_iter().map(|(_, q)| q));
 }

@@ -4,7 +4,7 @@
 
 use super::error::CellError;
 use super::meta::OpwParams;
-use super::robot::Robot;
+use super::robot::{JointKind, Robot};
 use nalgebra::{Isometry3, Vector3};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -33,6 +33,18 @@ impl Opw {
                 format!(
                     "OPW parameters given for a robot with {} moving joints (need 6)",
                     robot.dof()
+                ),
+            ));
+        }
+        if let Some(j) = robot
+            .active_joints()
+            .find(|j| !matches!(j.kind, JointKind::Revolute | JointKind::Continuous))
+        {
+            return Err(CellError::urdf(
+                path,
+                format!(
+                    "OPW parameters need six revolute joints; `{}` is not revolute",
+                    j.name
                 ),
             ));
         }
