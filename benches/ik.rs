@@ -43,6 +43,25 @@ fn bench_ik(c: &mut Criterion) {
         let seed = robot.home();
         // 100 % success on these reachable poses is a precondition of the figure.
         assert!(targets.iter().all(|p| robot.ik(p, &tcp, &seed).is_ok()));
+        let qs: Vec<Vec<f64>> = targets
+            .iter()
+            .map(|p| robot.ik(p, &tcp, &seed).unwrap()[0].clone())
+            .collect();
+        let mut k = 0;
+        c.bench_function(&format!("fk_tip/{name}"), |b| {
+            b.iter(|| {
+                k = (k + 1) % qs.len();
+                black_box(robot.fk_tip(black_box(&qs[k])))
+            })
+        });
+        let seed6: [f64; 6] = std::array::from_fn(|j| seed[j]);
+        let mut i = 0;
+        c.bench_function(&format!("ik6_full_pose/{name}"), |b| {
+            b.iter(|| {
+                i = (i + 1) % targets.len();
+                black_box(robot.ik6(black_box(&targets[i]), &tcp, &seed6)).ok()
+            })
+        });
         let mut i = 0;
         c.bench_function(&format!("ik_full_pose/{name}"), |b| {
             b.iter(|| {

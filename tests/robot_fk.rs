@@ -185,6 +185,11 @@ fn fk_matches_the_reference_urdfs_on_random_joints() {
                 .collect();
             let all_ref = reference.fk_all(&q);
             let all_own = robot.fk_all(&q);
+            // The IK's FK (fixed joints folded) agrees with the per-link FK.
+            let tip = robot.fk_tip(&q);
+            let tool0 = all_own[robot.link_index("tool0").unwrap()];
+            assert!((tip.translation.vector - tool0.translation.vector).norm() < 1e-12);
+            assert!(tip.rotation.angle_to(&tool0.rotation) < 1e-12);
             for name in [
                 "link_1", "link_2", "link_3", "link_4", "link_5", "link_6", "tool0",
             ] {

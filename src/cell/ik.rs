@@ -197,7 +197,7 @@ impl Robot {
     ) -> Result<Vec<[f64; 6]>, IkFailure> {
         let opw = self.opw.as_ref().expect("closed form");
         let raw = opw.solve(target, seed[3]);
-        if raw.candidates.is_empty() {
+        if raw.count == 0 {
             let (min_reach, reach) = opw.shoulder_reach();
             let [front, back] = raw.shoulder_distance;
             // Report the shoulder position that is nearer to being in range.
@@ -218,20 +218,49 @@ impl Robot {
             (j.lower, j.upper)
         });
         let mut within: Vec<([f64; 6], f64)> = Vec::with_capacity(32);
-        let mut best_violation: Option<(f64, IkFailure)> = None;
+        // FK check only where it matters: candidates with copies inside the limits now, the
+        // others only if nothing is left (to tell a joint limit from a numeric failure).
+        let exact = |q: &[f64; 6]| {
+            let (dp, dr) = self.residual(q, target);
+            (
+                dp <= options.position_tolerance && dr <= options.rotation_tolerance,
+                dp,
+                dr,
+            )
+        };
+        let mut beyond_limits = [0usize; 8];
+        let mut n_beyond = 0;
         let mut best_residual = (f64::INFINITY, f64::INFINITY);
-        for (cand, &t5) in raw.candidates.iter().zip(&raw.wrist_angles) {
-            let (dp, dr) = self.residual(cand, target);
-            if !(dp <= options.position_tolerance && dr <= options.rotation_tolerance) {
-                if dp + dr < best_residual.0 + best_residual.1 {
-                    best_residual = (dp, dr);
-                }
-                continue;
-            }
+        for k in 0..raw.count {
+            let cand = &raw.candidates[k];
+            let t5 = raw.wrist_angles[k];
             let wrist = t5.abs().min(PI - t5.abs());
             let before = within.len();
             push_turn_variants(cand, &limits, wrist, &mut within);
             if within.len() == before {
+                beyond_limits[n_beyond] = k;
+                n_beyond += 1;
+                continue;
+            }
+            let (ok, dp, dr) = exact(cand);
+            if !ok {
+                within.truncate(before);
+                if dp + dr < best_residual.0 + best_residual.1 {
+                    best_residual = (dp, dr);
+                }
+            }
+        }
+        let mut best_violation: Option<(f64, IkFailure)> = None;
+        if within.is_empty() {
+            for &k in &beyond_limits[..n_beyond] {
+                let cand = &raw.candidates[k];
+                let (ok, dp, dr) = exact(cand);
+                if !ok {
+                    if dp + dr < best_residual.0 + best_residual.1 {
+                        best_residual = (dp, dr);
+                    }
+                    continue;
+                }
                 let failure = self.worst_limit(cand, &limits);
                 if let IkFailure::JointLimit { excess, .. } = failure
                     && best_violation.as_ref().is_none_or(|(e, _)| excess < *e)

@@ -17,11 +17,13 @@ pub(crate) struct Opw {
 /// What the closed form found for one tool0 pose, before joint limits.
 pub(crate) struct OpwResult {
     /// Joint vectors in URDF joint values (not yet wrapped or limit-checked).
-    pub candidates: Vec<[f64; 6]>,
+    pub candidates: [[f64; 6]; 8],
+    /// Number of valid entries in `candidates` and `wrist_angles`.
+    pub count: usize,
     /// Wrist-centre distance from the front and the back shoulder position, m.
     pub shoulder_distance: [f64; 2],
     /// Internal wrist angle θ5 of each candidate (0 = axes 4 and 6 aligned).
-    pub wrist_angles: Vec<f64>,
+    pub wrist_angles: [f64; 8],
 }
 
 impl Opw {
@@ -143,9 +145,10 @@ impl Opw {
         let c2_2 = p.c2 * p.c2;
         let (s1, s2) = (s1_2.sqrt(), s2_2.sqrt());
         let mut out = OpwResult {
-            candidates: Vec::with_capacity(8),
+            candidates: [[0.0; 6]; 8],
+            count: 0,
             shoulder_distance: [s1, s2],
-            wrist_angles: Vec::with_capacity(8),
+            wrist_angles: [0.0; 8],
         };
         let tmp9 = 2.0 * p.c2 * kappa_2.sqrt();
         let tmp10 = p.a2.atan2(p.c3);
@@ -193,10 +196,10 @@ impl Opw {
         let s5 = (1.0 - m * m).sqrt();
         let push = |out: &mut OpwResult, t4: f64, t5: f64, t6: f64| {
             let t = [t1, t2, t3, t4, t5, t6];
-            out.candidates.push(std::array::from_fn(|i| {
-                wrap((t[i] + self.p.offsets[i]) * self.p.signs[i])
-            }));
-            out.wrist_angles.push(t5);
+            out.candidates[out.count] =
+                std::array::from_fn(|i| wrap((t[i] + self.p.offsets[i]) * self.p.signs[i]));
+            out.wrist_angles[out.count] = t5;
+            out.count += 1;
         };
         if s5 < 1e-9 {
             // Axes 4 and 6 are aligned: only θ4 + θ6 is defined. Keep θ4 at the hint.

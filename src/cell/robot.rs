@@ -39,6 +39,21 @@ pub struct Joint {
 }
 
 impl Joint {
+    /// The motion of the joint at value `q` (child frame relative to the joint origin).
+    pub fn motion(&self, q: f64) -> Isometry3<f64> {
+        match self.kind {
+            JointKind::Fixed => Isometry3::identity(),
+            JointKind::Revolute | JointKind::Continuous => Isometry3::from_parts(
+                Translation3::identity(),
+                UnitQuaternion::from_axis_angle(&self.axis, q),
+            ),
+            JointKind::Prismatic => Isometry3::from_parts(
+                Translation3::from(self.axis.into_inner() * q),
+                UnitQuaternion::identity(),
+            ),
+        }
+    }
+
     /// The child frame in the parent frame at joint value `q`.
     pub fn transform(&self, q: f64) -> Isometry3<f64> {
         match self.kind {
@@ -82,6 +97,10 @@ pub struct Robot {
     pub active: Vec<usize>,
     /// Indices into `joints` from the root to the tip link (fixed ones included).
     pub(crate) tip_path: Vec<usize>,
+    /// The root → tip path with fixed joints folded into the next moving joint's origin (and the
+    /// trailing ones into `tip_offset`): the FK that IK runs for every candidate.
+    pub(crate) tip_steps: Vec<(Isometry3<f64>, usize)>,
+    pub(crate) tip_offset: Isometry3<f64>,
     /// Index into `links` of the IK/FK tip (usually `tool0`).
     pub tip: usize,
     pub meta: RobotMeta,
@@ -134,11 +153,12 @@ impl Robot {
     /// Pose of the tip link (e.g. `tool0`) in the root frame.
     pub fn fk_tip(&self, q: &[f64]) -> Isometry3<f64> {
         let mut pose = Isometry3::identity();
-        for &j in &self.tip_path {
-            let joint = &self.joints[j];
-            pose *= joint.transform(joint.dof_index.map_or(0.0, |i| q[i]));
+        for (i, (origin, j)) in self.tip_steps.iter().enumerate() {
+            let joint = &self.joints[*j];
+            // `origin` already holds the fixed joints before this one and its own origin.
+            pose = pose * origin * joint.motion(q[i]);
         }
-        pose
+        pose * self.tip_offset
     }
 
     /// Pose of the named link in the root frame.
@@ -362,7 +382,20 @@ fn build_tree(path: &Path, urdf: &urdf_rs::Robot, meta: &RobotMeta) -> Result<Ro
     for (i, &j) in active.iter().enumerate() {
         out_joints[j].dof_index = Some(i);
     }
+    let mut tip_steps = vec![];
+    let mut pending = Isometry3::identity();
+    for &j in &tip_path {
+        let joint = &out_joints[j];
+        if joint.kind == JointKind::Fixed {
+            pending *= joint.origin;
+        } else {
+            tip_steps.push((pending * joint.origin, j));
+            pending = Isometry3::identity();
+        }
+    }
     Ok(Robot {
+        tip_steps,
+        tip_offset: pending,
         name: meta.name.clone().unwrap_or_else(|| urdf.name.clone()),
         links,
         joints: out_joints,

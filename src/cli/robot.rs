@@ -51,7 +51,8 @@ pub enum RobotCommand {
         /// Print JSON (`{"solutions": …}` or `{"error": …}`) instead of text.
         #[arg(long)]
         json: bool,
-        /// Print solve-time statistics (IK calls only, no parsing or output) to stderr as JSON.
+        /// Print solve-time statistics to stderr as JSON: the time of each library IK call
+        /// (`Robot::ik6` for 6-axis arms), without parsing or output.
         #[arg(long)]
         stats: bool,
     },
@@ -189,10 +190,34 @@ struct Solver {
     seed: Vec<f64>,
 }
 
+/// Solutions of one pose: fixed-size for 6-axis arms (the fast path), any length otherwise.
+enum Answer {
+    Six(Vec<[f64; 6]>),
+    Any(Vec<Vec<f64>>),
+}
+
+impl Answer {
+    fn rows(&self) -> Vec<&[f64]> {
+        match self {
+            Answer::Six(s) => s.iter().map(|q| q.as_slice()).collect(),
+            Answer::Any(s) => s.iter().map(|q| q.as_slice()).collect(),
+        }
+    }
+}
+
 impl Solver {
-    fn answer_json(result: &Result<Vec<Vec<f64>>, IkFailure>) -> String {
+    fn solve(&self, pose: &Isometry3<f64>) -> Result<Answer, IkFailure> {
+        if self.robot.dof() == 6 {
+            let seed: [f64; 6] = std::array::from_fn(|i| self.seed[i]);
+            self.robot.ik6(pose, &self.tcp, &seed).map(Answer::Six)
+        } else {
+            self.robot.ik(pose, &self.tcp, &self.seed).map(Answer::Any)
+        }
+    }
+
+    fn answer_json(result: &Result<Answer, IkFailure>) -> String {
         match result {
-            Ok(sols) => json!({ "solutions": sols }).to_string(),
+            Ok(sols) => json!({ "solutions": sols.rows() }).to_string(),
             // Serialised directly so that `kind` comes first, then the numbers.
             Err(fail) => format!(
                 "{{\"error\":{}}}",
@@ -201,11 +226,12 @@ impl Solver {
         }
     }
 
-    fn answer_text(result: &Result<Vec<Vec<f64>>, IkFailure>) -> String {
+    fn answer_text(result: &Result<Answer, IkFailure>) -> String {
         match result {
             Ok(sols) => {
-                let mut s = format!("{} solution(s), closest first (rad):\n", sols.len());
-                for q in sols {
+                let rows = sols.rows();
+                let mut s = format!("{} solution(s), closest first (rad):\n", rows.len());
+                for q in rows {
                     let cells: Vec<String> = q.iter().map(|v| format!("{v:>10.6}")).collect();
                     s.push_str(&format!("  {}\n", cells.join(" ")));
                 }
@@ -219,7 +245,7 @@ impl Solver {
         let values = parse_numbers(pose, |c| c == ',')
             .map_err(|e| Failure::bad_input(format!("--pose: {e}")))?;
         let pose = parse_pose(&values).map_err(|e| Failure::bad_input(format!("--pose: {e}")))?;
-        let result = self.robot.ik(&pose, &self.tcp, &self.seed);
+        let result = self.solve(&pose);
         let text = if json {
             format!("{}\n", Self::answer_json(&result))
         } else {
@@ -255,7 +281,7 @@ impl Solver {
         let mut results = Vec::with_capacity(poses.len());
         for pose in &poses {
             let start = Instant::now();
-            let result = self.robot.ik(pose, &self.tcp, &self.seed);
+            let result = self.solve(pose);
             times.push(start.elapsed().as_secs_f64());
             results.push(result);
         }
