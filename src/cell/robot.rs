@@ -82,6 +82,9 @@ pub struct Link {
     pub collisions: Vec<PlacedShape>,
     pub visuals: Vec<PlacedShape>,
     pub inertial: Option<Inertial>,
+    /// Mesh geometries in the URDF that were not loaded (framewright uses primitives only);
+    /// callers may warn that the link's collision shape is incomplete.
+    pub skipped_meshes: usize,
 }
 
 /// A serial-chain robot (any number of moving joints on the path from the root to the tip;
@@ -257,16 +260,15 @@ fn build_tree(path: &Path, urdf: &urdf_rs::Robot, meta: &RobotMeta) -> Result<Ro
         links.push(Link {
             name: l.name.clone(),
             parent_joint,
-            collisions: shapes(
-                path,
-                &l.name,
-                l.collision.iter().map(|c| (&c.origin, &c.geometry)),
-            )?,
-            visuals: shapes(
-                path,
-                &l.name,
-                l.visual.iter().map(|v| (&v.origin, &v.geometry)),
-            )?,
+            collisions: shapes(l.collision.iter().map(|c| (&c.origin, &c.geometry))),
+            visuals: shapes(l.visual.iter().map(|v| (&v.origin, &v.geometry))),
+            skipped_meshes: l
+                .collision
+                .iter()
+                .map(|c| &c.geometry)
+                .chain(l.visual.iter().map(|v| &v.geometry))
+                .filter(|g| matches!(g, urdf_rs::Geometry::Mesh { .. }))
+                .count(),
             inertial: (l.inertial.mass.value > 0.0).then(|| Inertial {
                 mass: l.inertial.mass.value,
                 origin: isometry_from_xyz_rpy(l.inertial.origin.xyz.0, l.inertial.origin.rpy.0),
@@ -282,7 +284,21 @@ fn build_tree(path: &Path, urdf: &urdf_rs::Robot, meta: &RobotMeta) -> Result<Ro
         });
     }
 
-    let tip_name = meta.tip_link.clone().unwrap_or_else(|| "tool0".into());
+    // The tip: the metadata's `tip_link`, else `tool0`, else the only leaf link.
+    let leaves: Vec<usize> = (0..links.len())
+        .filter(|&i| !joints.iter().any(|(_, j)| j.parent.link == links[i].name))
+        .collect();
+    let tip_name = match &meta.tip_link {
+        Some(t) => t.clone(),
+        None if links.iter().any(|l| l.name == "tool0") => "tool0".into(),
+        None if leaves.len() == 1 => links[leaves[0]].name.clone(),
+        None => {
+            let names: Vec<&str> = leaves.iter().map(|&i| links[i].name.as_str()).collect();
+            return Err(err(format!(
+                "no `tool0` link and several end links {names:?}: name the tip with `tip_link` in the robot's metadata file"
+            )));
+        }
+    };
     let tip = links
         .iter()
         .position(|l| l.name == tip_name)
@@ -408,10 +424,8 @@ fn build_tree(path: &Path, urdf: &urdf_rs::Robot, meta: &RobotMeta) -> Result<Ro
 }
 
 fn shapes<'a>(
-    path: &Path,
-    link: &str,
     items: impl Iterator<Item = (&'a urdf_rs::Pose, &'a urdf_rs::Geometry)>,
-) -> Result<Vec<PlacedShape>, CellError> {
+) -> Vec<PlacedShape> {
     let mut out = vec![];
     for (origin, geometry) in items {
         let shape = match geometry {
@@ -427,7 +441,7 @@ fn shapes<'a>(
                 length: *length,
             },
             urdf_rs::Geometry::Sphere { radius } => Shape::Sphere { radius: *radius },
-            // Meshes are not loaded: framewright works with primitives only.
+            // Meshes are not loaded (counted in `Link::skipped_meshes`).
             urdf_rs::Geometry::Mesh { .. } => continue,
         };
         out.push(PlacedShape {
@@ -435,6 +449,5 @@ fn shapes<'a>(
             shape,
         });
     }
-    let _ = (path, link);
-    Ok(out)
+    out
 }
