@@ -290,3 +290,27 @@ fn non_finite_pose_is_refused() {
         Err(IkFailure::InvalidPose)
     );
 }
+
+#[test]
+fn near_singular_wrists_round_trip() {
+    // Both formulas meet at the switch to the singular branch; every wrist angle must work.
+    for name in ROBOTS {
+        let robot = Robot::load(name).unwrap();
+        for (k, q5) in [
+            0.0, 1e-12, 1e-10, 1e-9, 3e-8, 1e-7, 2e-7, 1e-6, 1e-5, -1e-8, -1e-6,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let q = [0.3 - 0.1 * k as f64, -0.5, 0.6, 0.4, q5, -0.7];
+            let pose = robot.fk_tip(&q);
+            let sols = robot
+                .ik(&pose, &Isometry3::identity(), &robot.home())
+                .unwrap_or_else(|e| panic!("{name} q5={q5}: {e}"));
+            for s in &sols {
+                let (dp, dr) = pose_error(&robot.fk_tip(s), &pose);
+                assert!(dp <= 1e-6 && dr <= 1e-6, "{name} q5={q5}: {dp} {dr}");
+            }
+        }
+    }
+}

@@ -201,7 +201,7 @@ impl Opw {
             out.wrist_angles[out.count] = t5;
             out.count += 1;
         };
-        if s5 < 1e-9 {
+        if s5 < 1e-7 {
             // Axes 4 and 6 are aligned: only θ4 + θ6 is defined. Keep θ4 at the hint.
             let phi = yc.dot(&col0).atan2(xc.dot(&col0));
             let t4 = self.internal(3, q4_hint);
