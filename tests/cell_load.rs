@@ -197,3 +197,51 @@ fn study_layout_reproduces_the_unreachable_top_plate() {
         }
     }
 }
+
+#[test]
+fn wall_laid_flat_follows_the_assembly_keys() {
+    use nalgebra::{Point3, Vector3};
+    let cell = Cell::load("study-abb").unwrap();
+    let (length, height) = (6.86, 2.44);
+    let t = cell.assembly.wall_to_cell(length, height);
+    // Parallel: the wall's bottom edge at x = 0.531, its top at x = 0.531 + height, centred on y = 0.
+    let bottom_start = t * Point3::new(0.0, 0.0, 0.0);
+    let top_end = t * Point3::new(length, height, 0.0);
+    assert!(
+        (bottom_start - Point3::new(0.531, 3.43, 0.0)).norm() < 1e-12,
+        "{bottom_start}"
+    );
+    assert!(
+        (top_end - Point3::new(0.531 + 2.44, -3.43, 0.0)).norm() < 1e-12,
+        "{top_end}"
+    );
+    // w (across the thickness) points up: the outer face lies on the floor.
+    assert!((t.rotation * Vector3::z() - Vector3::z()).norm() < 1e-12);
+    // Perpendicular: the length runs along +x from offset_x, the height centred on y.
+    let mut perpendicular = cell.assembly;
+    perpendicular.orientation = Orientation::Perpendicular;
+    let t = perpendicular.wall_to_cell(length, height);
+    let p = t * Point3::new(length, height, 0.089);
+    assert!(
+        (p - Point3::new(0.531 + 6.86, 1.22, 0.089)).norm() < 1e-12,
+        "{p}"
+    );
+}
+
+#[test]
+fn pick_without_enough_margin_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/cells/study-abb.toml"),
+    )
+    .unwrap()
+    .replace("min_reach_margin = 0.10", "min_reach_margin = 1.50");
+    let file = dir.path().join("tight.toml");
+    std::fs::write(&file, text).unwrap();
+    let msg = Cell::load(file.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        msg.contains("key `touch_sensor.pick_offset`")
+            && msg.contains("to spare; at least 1.500 m"),
+        "{msg}"
+    );
+}

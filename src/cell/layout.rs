@@ -168,6 +168,34 @@ pub struct Assembly {
     pub surface_z: f64,
 }
 
+impl Assembly {
+    /// Where a wall frame lies in the cell frame when the wall is laid flat here: maps wall
+    /// coordinates (u along the wall, v up the wall, w = u × v across its thickness from the
+    /// outer face) to cell coordinates. The outer face lies on the surface (w points up).
+    /// * parallel: v (height) runs along +x from `offset_x`, u along −y, centred on `centre_y`;
+    /// * perpendicular: u (length) runs along +x from `offset_x`, v along +y, the height
+    ///   centred on `centre_y`.
+    pub fn wall_to_cell(&self, length: f64, height: f64) -> Isometry3<f64> {
+        let (origin, u, v) = match self.orientation {
+            Orientation::Parallel => (
+                Vector3::new(self.offset_x, self.centre_y + length / 2.0, self.surface_z),
+                -Vector3::y(),
+                Vector3::x(),
+            ),
+            Orientation::Perpendicular => (
+                Vector3::new(self.offset_x, self.centre_y - height / 2.0, self.surface_z),
+                Vector3::x(),
+                Vector3::y(),
+            ),
+        };
+        let rot = nalgebra::Rotation3::from_basis_unchecked(&[u, v, u.cross(&v)]);
+        Isometry3::from_parts(
+            Translation3::from(origin),
+            UnitQuaternion::from_rotation_matrix(&rot),
+        )
+    }
+}
+
 /// A belt conveyor. `pose`: centre of the belt's top surface, x along the travel direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Conveyor {
