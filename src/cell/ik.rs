@@ -155,12 +155,24 @@ impl Robot {
         self.opw.as_ref().map(|o| o.shoulder_reach())
     }
 
-    /// 6-axis IK as fixed-size arrays (the executor's and the bench's form).
+    /// 6-axis IK as fixed-size arrays (the executor's and the bench's form); same answers as
+    /// `ik`. Panics for robots without 6 moving joints (a programming error).
     pub fn ik6(
         &self,
         pose: &Isometry3<f64>,
         tcp: &Isometry3<f64>,
         seed: &[f64; 6],
+    ) -> Result<Vec<[f64; 6]>, IkFailure> {
+        self.ik6_with(pose, tcp, seed, &IkOptions::default())
+    }
+
+    /// `ik6` with explicit tolerances and wrist margin.
+    pub fn ik6_with(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64; 6],
+        options: &IkOptions,
     ) -> Result<Vec<[f64; 6]>, IkFailure> {
         assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
         let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
@@ -168,18 +180,17 @@ impl Robot {
             return Err(IkFailure::InvalidPose);
         }
         let target = pose * tcp.inverse();
-        let options = IkOptions::default();
         match &self.opw {
-            Some(_) => self.ik_closed_form(&target, seed, &options),
+            Some(_) => self.ik_closed_form(&target, seed, options),
             None => Ok(self
-                .ik_numeric(&target, seed, &options)?
+                .ik_numeric(&target, seed, options)?
                 .into_iter()
                 .map(|s| std::array::from_fn(|i| s[i]))
                 .collect()),
         }
     }
 
-    /// Whether FK of `q` puts the tip on `target` within the tolerances.
+    /// Distance (m) and rotation angle (rad) between the tip at `q` and `target`.
     pub(crate) fn residual(&self, q: &[f64], target: &Isometry3<f64>) -> (f64, f64) {
         let got = self.fk_tip(q);
         (
