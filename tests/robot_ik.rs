@@ -75,6 +75,14 @@ fn round_trip_10000_random_joint_vectors() {
                 sols.windows(2).all(|w| dist(&w[0]) <= dist(&w[1])),
                 "{name} #{n}: not sorted"
             );
+            if n % 100 == 0 {
+                let seed6: [f64; 6] = std::array::from_fn(|i| home[i]);
+                let six = robot.ik6(&pose, &tcp, &seed6).unwrap();
+                assert!(
+                    six.iter().map(|s| s.to_vec()).eq(sols.iter().cloned()),
+                    "{name} #{n}: ik6 differs from ik"
+                );
+            }
             if sols
                 .iter()
                 .any(|s| s.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-6))
