@@ -5,11 +5,11 @@
 use super::opw::wrap;
 use super::robot::Robot;
 use nalgebra::Isometry3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// Why IK gave no solution. Serialises as `{"kind": "out_of_reach", "distance": …, …}`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum IkFailure {
     /// The wrist centre (OPW) or the tip (numeric IK) is farther from the shoulder than the arm
