@@ -139,6 +139,8 @@ fn out_of_reach_reports_distance_and_reach() {
             json.starts_with(r#"{"kind":"out_of_reach","distance":"#),
             "{json}"
         );
+        let back: IkFailure = serde_json::from_str(&json).unwrap();
+        assert!(matches!(back, IkFailure::OutOfReach { .. }));
     }
 }
 
