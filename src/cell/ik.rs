@@ -297,20 +297,26 @@ impl Robot {
                 required: options.wrist_margin,
             });
         }
-        // Sort by distance to the seed (computed once each), ties lexicographic; drop duplicates.
+        // Sort small (distance, index) keys, ties by generation order (deterministic), then
+        // gather, dropping exact duplicates (equal distance, so adjacent).
         let dist = |q: &[f64; 6]| -> f64 { q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum() };
-        let mut keyed: Vec<(f64, [f64; 6])> = within.iter().map(|(q, _)| (dist(q), *q)).collect();
-        keyed.sort_by(|(da, a), (db, b)| {
-            da.total_cmp(db).then_with(|| {
-                a.iter()
-                    .zip(b)
-                    .fold(std::cmp::Ordering::Equal, |o, (x, y)| {
-                        o.then(x.total_cmp(y))
-                    })
-            })
-        });
-        keyed.dedup_by(|a, b| a.1.iter().zip(&b.1).all(|(x, y)| (x - y).abs() < 1e-9));
-        Ok(keyed.into_iter().map(|(_, q)| q).collect())
+        let mut keys: Vec<(f64, usize)> = within
+            .iter()
+            .enumerate()
+            .map(|(i, (q, _))| (dist(q), i))
+            .collect();
+        keys.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut out: Vec<[f64; 6]> = Vec::with_capacity(keys.len());
+        for (_, i) in keys {
+            let q = within[i].0;
+            if out.last().is_some_and(|last: &[f64; 6]| {
+                last.iter().zip(&q).all(|(x, y)| (x - y).abs() < 1e-9)
+            }) {
+                continue;
+            }
+            out.push(q);
+        }
+        Ok(out)
     }
 
     /// The limit violation of `q` that matters most (largest excess, whole turns allowed).

@@ -159,7 +159,17 @@ impl Robot {
         for (i, (origin, j)) in self.tip_steps.iter().enumerate() {
             let joint = &self.joints[*j];
             // `origin` already holds the fixed joints before this one and its own origin.
-            pose = pose * origin * joint.motion(q[i]);
+            pose *= origin;
+            match joint.kind {
+                // A pure rotation: compose the rotations only (this FK checks every IK answer).
+                JointKind::Revolute | JointKind::Continuous => {
+                    pose.rotation *= UnitQuaternion::from_axis_angle(&joint.axis, q[i]);
+                }
+                JointKind::Prismatic => {
+                    pose.translation.vector += pose.rotation * (joint.axis.into_inner() * q[i]);
+                }
+                JointKind::Fixed => {}
+            }
         }
         pose * self.tip_offset
     }
