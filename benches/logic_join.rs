@@ -86,10 +86,12 @@ fn bench(cr: &mut Criterion) {
     });
     g.bench_function("handwritten_ascent", |bch| {
         bch.iter(|| {
-            let mut p = HandJoin::default();
-            p.a = a.clone();
-            p.b = b.clone();
-            p.c = c.clone();
+            let mut p = HandJoin {
+                a: a.clone(),
+                b: b.clone(),
+                c: c.clone(),
+                ..Default::default()
+            };
             p.run();
             p.j.len()
         })

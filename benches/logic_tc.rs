@@ -67,19 +67,24 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("handwritten_ascent", |b| {
         b.iter(|| {
-            let mut p = HandTc::default();
-            p.edge = edges.clone();
+            let mut p = HandTc {
+                edge: edges.clone(),
+                ..Default::default()
+            };
             p.run();
             p.path.len()
         })
     });
     g.bench_function("handwritten_ascent_values", |b| {
         b.iter(|| {
-            let mut p = HandTc::default();
-            p.edge = vals
+            let edge = vals
                 .iter()
                 .map(|t| (t[0].as_number().unwrap(), t[1].as_number().unwrap()))
                 .collect();
+            let mut p = HandTc {
+                edge,
+                ..Default::default()
+            };
             p.run();
             let mut out: Vec<Vec<Value>> = p
                 .path

@@ -1,1 +1,44 @@
-//! cell (being built).
+//! The robot cell: robots from URDF (links, joints, collision primitives, FK), closed-form and
+//! numeric IK with failure reasons as data, tools with TCP frames, and cell layouts from TOML.
+//!
+//! Frames: every robot pose is in its `base_link` (z up); cell positions are in the cell frame
+//! (floor at z = 0). SI units throughout (m, kg, s, rad); TOML files say `_deg` where they use
+//! degrees.
+
+mod builtin;
+mod dls;
+mod error;
+mod ik;
+mod layout;
+mod load;
+mod meta;
+mod opw;
+mod robot;
+mod shapes;
+mod toml_file;
+mod tool;
+
+pub use builtin::{cell_names, robot_names, tool_names};
+pub use error::CellError;
+pub use ik::{IkFailure, IkOptions};
+pub use layout::{Assembly, Cell, Conveyor, Floor, Orientation, Pick, ToolTable, TouchSensor};
+pub use meta::{OpwParams, RobotMeta};
+pub use robot::{Inertial, Joint, JointKind, Link, Robot};
+pub use shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};
+pub use tool::{Gripper, Tool, ToolPart};
+
+use nalgebra::Isometry3;
+
+/// A pose as a 4×4 row-major matrix (rows of the homogeneous transform).
+pub fn matrix_rows(pose: &Isometry3<f64>) -> [[f64; 4]; 4] {
+    let m = pose.to_homogeneous();
+    std::array::from_fn(|r| std::array::from_fn(|c| m[(r, c)]))
+}
+
+pub(crate) fn serialize_isometry<S: serde::Serializer>(
+    pose: &Isometry3<f64>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::Serialize;
+    matrix_rows(pose).serialize(s)
+}

@@ -1,0 +1,586 @@
+//! Cell layouts (`robots/cells/*.toml`): robot and base pose, tool, assembly area, the two
+//! conveyors, the touch sensor at the end of conveyor 2, the tool table and the floor.
+//! Positions are in the cell frame (z up, floor at z = 0 unless moved).
+
+use super::builtin;
+use super::error::CellError;
+use super::ik::IkFailure;
+use super::load::looks_like_path;
+use super::robot::Robot;
+use super::toml_file;
+use super::tool::Tool;
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CellFile {
+    name: Option<String>,
+    description: Option<String>,
+    robot: RobotSection,
+    tool: ToolSection,
+    #[serde(default)]
+    assembly: AssemblySection,
+    conveyor1: Conveyor1Section,
+    conveyor2: Conveyor2Section,
+    #[serde(default)]
+    touch_sensor: SensorSection,
+    tool_table: TableSection,
+    #[serde(default)]
+    floor: FloorSection,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RobotSection {
+    model: String,
+    #[serde(default)]
+    base_position: [f64; 3],
+    #[serde(default)]
+    base_yaw_deg: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ToolSection {
+    model: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct AssemblySection {
+    offset_x: f64,
+    orientation: Orientation,
+    centre_y: f64,
+    surface_z: f64,
+}
+
+impl Default for AssemblySection {
+    fn default() -> Self {
+        AssemblySection {
+            offset_x: 0.531,
+            orientation: Orientation::Parallel,
+            centre_y: 0.0,
+            surface_z: 0.0,
+        }
+    }
+}
+
+/// How the wall's length lies relative to the robot's y axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Orientation {
+    /// Wall length along robot y, wall height along +x.
+    Parallel,
+    /// Wall length along robot +x, wall height along y.
+    Perpendicular,
+}
+
+fn speed_1() -> f64 {
+    0.05
+}
+fn speed_2() -> f64 {
+    2.0
+}
+fn gap() -> f64 {
+    0.150
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Conveyor1Section {
+    position: [f64; 3],
+    direction_deg: f64,
+    length: f64,
+    width: f64,
+    #[serde(default = "speed_1")]
+    speed: f64,
+    #[serde(default = "gap")]
+    lumber_gap: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Conveyor2Section {
+    position: [f64; 3],
+    direction_deg: f64,
+    length: f64,
+    width: f64,
+    #[serde(default = "speed_2")]
+    speed: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct SensorSection {
+    size: [f64; 3],
+    pick_offset: f64,
+    pick_heights: Vec<f64>,
+    min_reach_margin: f64,
+}
+
+impl Default for SensorSection {
+    fn default() -> Self {
+        SensorSection {
+            size: [0.05, 0.30, 0.20],
+            pick_offset: 0.45,
+            pick_heights: vec![0.089, 0.140],
+            min_reach_margin: 0.10,
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TableSection {
+    position: [f64; 3],
+    size: [f64; 3],
+    leg_height: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct FloorSection {
+    size: [f64; 2],
+    z: f64,
+}
+
+impl Default for FloorSection {
+    fn default() -> Self {
+        FloorSection {
+            size: [20.0, 20.0],
+            z: 0.0,
+        }
+    }
+}
+
+/// Where the wall is laid flat for framing.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Assembly {
+    /// Distance (m) from the robot base origin along +x to the wall's bottom edge
+    /// (parallel) or to its start (perpendicular).
+    pub offset_x: f64,
+    pub orientation: Orientation,
+    /// The wall is centred on this y (m, robot frame).
+    pub centre_y: f64,
+    /// Height (m) of the surface the wall lies on.
+    pub surface_z: f64,
+}
+
+impl Assembly {
+    /// Where a wall frame lies in the cell frame when the wall is laid flat here: maps wall
+    /// coordinates (u along the wall, v up the wall, w = u × v across its thickness from the
+    /// outer face) to cell coordinates. The outer face lies on the surface (w points up).
+    /// * parallel: v (height) runs along +x from `offset_x`, u along −y, centred on `centre_y`;
+    /// * perpendicular: u (length) runs along +x from `offset_x`, v along +y, the height
+    ///   centred on `centre_y`.
+    pub fn wall_to_cell(&self, length: f64, height: f64) -> Isometry3<f64> {
+        let (origin, u, v) = match self.orientation {
+            Orientation::Parallel => (
+                Vector3::new(self.offset_x, self.centre_y + length / 2.0, self.surface_z),
+                -Vector3::y(),
+                Vector3::x(),
+            ),
+            Orientation::Perpendicular => (
+                Vector3::new(self.offset_x, self.centre_y - height / 2.0, self.surface_z),
+                Vector3::x(),
+                Vector3::y(),
+            ),
+        };
+        let rot = nalgebra::Rotation3::from_basis_unchecked(&[u, v, u.cross(&v)]);
+        Isometry3::from_parts(
+            Translation3::from(origin),
+            UnitQuaternion::from_rotation_matrix(&rot),
+        )
+    }
+}
+
+/// A belt conveyor. `pose`: centre of the belt's top surface, x along the travel direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Conveyor {
+    pub pose: Isometry3<f64>,
+    pub length: f64,
+    pub width: f64,
+    /// Belt speed, m/s.
+    pub speed: f64,
+}
+
+impl Conveyor {
+    pub fn direction(&self) -> Vector3<f64> {
+        self.pose.rotation * Vector3::x()
+    }
+    /// Centre of the downstream edge of the belt's top surface.
+    pub fn downstream_end(&self) -> Point3<f64> {
+        self.pose * Point3::new(self.length / 2.0, 0.0, 0.0)
+    }
+    pub fn upstream_end(&self) -> Point3<f64> {
+        self.pose * Point3::new(-self.length / 2.0, 0.0, 0.0)
+    }
+}
+
+/// The touch sensor box at the downstream end of conveyor 2 (`pose`: its centre, x along the
+/// belt); lumber stops when its leading end touches the sensor face.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TouchSensor {
+    pub pose: Isometry3<f64>,
+    pub size: [f64; 3],
+    /// Centre of the face the lumber touches (at belt top height).
+    pub face: Point3<f64>,
+}
+
+/// Where the robot picks lumber: `pick_offset` back from the sensor face, on the belt centre line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pick {
+    /// Grip point at belt-top height (add the lumber height for the grip TCP), cell frame.
+    pub point: Point3<f64>,
+    pub offset: f64,
+    /// Lumber heights on the belt checked for reach (m), with the reach margin found (m).
+    pub margins: Vec<(f64, f64)>,
+    pub min_reach_margin: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToolTable {
+    /// Centre of the table top's upper face.
+    pub top_centre: Point3<f64>,
+    /// Length (x), width (y), top thickness (z).
+    pub size: [f64; 3],
+    pub leg_height: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Floor {
+    pub size: [f64; 2],
+    pub z: f64,
+}
+
+/// A loaded and checked cell.
+#[derive(Debug, Clone)]
+pub struct Cell {
+    pub name: String,
+    pub description: Option<String>,
+    /// The file it came from (`robots/cells/<name>.toml` for built-ins).
+    pub source: PathBuf,
+    pub robot: Robot,
+    /// base_link in the cell frame.
+    pub robot_base: Isometry3<f64>,
+    pub tool: Tool,
+    pub assembly: Assembly,
+    pub conveyor1: Conveyor,
+    pub conveyor2: Conveyor,
+    /// Gap between lumber pieces on conveyor 1, m.
+    pub lumber_gap: f64,
+    pub touch_sensor: TouchSensor,
+    pub pick: Pick,
+    pub tool_table: ToolTable,
+    pub floor: Floor,
+}
+
+impl Cell {
+    /// A built-in cell (`study-abb`, `study-kuka`) or a cell TOML file.
+    pub fn load(name_or_path: &str) -> Result<Cell, CellError> {
+        if let Some(&(_, file, text)) = builtin::CELLS.iter().find(|c| c.0 == name_or_path) {
+            return Cell::parse(Path::new(file), text, true);
+        }
+        if !looks_like_path(name_or_path) && !Path::new(name_or_path).exists() {
+            return Err(CellError::UnknownName {
+                what: "cell",
+                name: name_or_path.to_string(),
+                known: builtin::cell_names().join(", "),
+            });
+        }
+        let path = Path::new(name_or_path);
+        let text = std::fs::read_to_string(path).map_err(|source| CellError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Cell::parse(path, &text, false)
+    }
+
+    /// The grip TCP pose (cell frame) for picking lumber of `height` on conveyor 2: TCP z down,
+    /// TCP y along the belt (the lumber's long axis).
+    pub fn pick_pose(&self, height: f64) -> Isometry3<f64> {
+        let y = self.conveyor2.direction();
+        let z = -Vector3::z();
+        let x = y.cross(&z);
+        let rot = nalgebra::Rotation3::from_basis_unchecked(&[x, y, z]);
+        Isometry3::from_parts(
+            Translation3::from(self.pick.point.coords + Vector3::new(0.0, 0.0, height)),
+            UnitQuaternion::from_rotation_matrix(&rot),
+        )
+    }
+
+    /// A cell-frame pose in the robot's base_link frame.
+    pub fn to_robot(&self, pose: &Isometry3<f64>) -> Isometry3<f64> {
+        self.robot_base.inverse() * pose
+    }
+
+    fn parse(path: &Path, text: &str, builtin: bool) -> Result<Cell, CellError> {
+        let f: CellFile = toml_file::parse(path, text)?;
+        let bad = |section: &str, key: &str, msg: String| {
+            toml_file::value_error(path, text, section, key, msg)
+        };
+        // Models: built-in names, or paths relative to this file.
+        let resolve = |model: &str| -> String {
+            if builtin || !looks_like_path(model) || Path::new(model).is_absolute() {
+                model.to_string()
+            } else {
+                path.parent()
+                    .unwrap_or(Path::new(""))
+                    .join(model)
+                    .to_string_lossy()
+                    .into_owned()
+            }
+        };
+        let robot = Robot::load(&resolve(&f.robot.model))
+            .map_err(|e| bad("robot", "model", e.to_string()))?;
+        let tool =
+            Tool::load(&resolve(&f.tool.model)).map_err(|e| bad("tool", "model", e.to_string()))?;
+
+        // Numbers: finite, positive where they are sizes, within a plausible factory hall.
+        let coord = |section: &str, key: &str, v: &[f64]| -> Result<(), CellError> {
+            match v.iter().find(|x| !(x.is_finite() && x.abs() <= 1000.0)) {
+                Some(x) => Err(bad(
+                    section,
+                    key,
+                    format!("expected coordinates in m within ±1000, got {x}"),
+                )),
+                None => Ok(()),
+            }
+        };
+        let size = |section: &str, key: &str, v: &[f64], max: f64| -> Result<(), CellError> {
+            match v
+                .iter()
+                .find(|x| !(x.is_finite() && **x > 0.0 && **x <= max))
+            {
+                Some(x) => Err(bad(
+                    section,
+                    key,
+                    format!("expected a size in m above 0 and at most {max}, got {x}"),
+                )),
+                None => Ok(()),
+            }
+        };
+        let speed = |section: &str, v: f64| -> Result<(), CellError> {
+            if v.is_finite() && v > 0.0 && v <= 10.0 {
+                Ok(())
+            } else {
+                Err(bad(
+                    section,
+                    "speed",
+                    format!("expected a belt speed in m/s above 0 and at most 10, got {v}"),
+                ))
+            }
+        };
+        let finite_angle = |section: &str, key: &str, v: f64| -> Result<(), CellError> {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(
+                    section,
+                    key,
+                    format!("expected an angle in degrees, got {v}"),
+                ))
+            }
+        };
+        coord("robot", "base_position", &f.robot.base_position)?;
+        finite_angle("robot", "base_yaw_deg", f.robot.base_yaw_deg)?;
+        let a = &f.assembly;
+        if !(a.offset_x.is_finite() && (0.0..=100.0).contains(&a.offset_x)) {
+            return Err(bad(
+                "assembly",
+                "offset_x",
+                format!("expected a distance in m from 0 to 100, got {}", a.offset_x),
+            ));
+        }
+        coord("assembly", "centre_y", &[a.centre_y])?;
+        coord("assembly", "surface_z", &[a.surface_z])?;
+        let c1 = &f.conveyor1;
+        coord("conveyor1", "position", &c1.position)?;
+        finite_angle("conveyor1", "direction_deg", c1.direction_deg)?;
+        size("conveyor1", "length", &[c1.length], 100.0)?;
+        size("conveyor1", "width", &[c1.width], 10.0)?;
+        speed("conveyor1", c1.speed)?;
+        if !(c1.lumber_gap.is_finite() && (0.0..=10.0).contains(&c1.lumber_gap)) {
+            return Err(bad(
+                "conveyor1",
+                "lumber_gap",
+                format!("expected a gap in m from 0 to 10, got {}", c1.lumber_gap),
+            ));
+        }
+        let c2 = &f.conveyor2;
+        coord("conveyor2", "position", &c2.position)?;
+        finite_angle("conveyor2", "direction_deg", c2.direction_deg)?;
+        size("conveyor2", "length", &[c2.length], 100.0)?;
+        size("conveyor2", "width", &[c2.width], 10.0)?;
+        speed("conveyor2", c2.speed)?;
+        let s = &f.touch_sensor;
+        size("touch_sensor", "size", &s.size, 5.0)?;
+        if !(s.pick_offset.is_finite() && s.pick_offset >= 0.0 && s.pick_offset <= c2.length) {
+            return Err(bad(
+                "touch_sensor",
+                "pick_offset",
+                format!(
+                    "expected a distance in m from 0 to the length of conveyor 2 ({}), got {}",
+                    c2.length, s.pick_offset
+                ),
+            ));
+        }
+        size("touch_sensor", "pick_heights", &s.pick_heights, 2.0)?;
+        if s.pick_heights.is_empty() {
+            return Err(bad(
+                "touch_sensor",
+                "pick_heights",
+                "expected at least one lumber height in m".into(),
+            ));
+        }
+        if !(s.min_reach_margin.is_finite() && (0.0..=5.0).contains(&s.min_reach_margin)) {
+            return Err(bad(
+                "touch_sensor",
+                "min_reach_margin",
+                format!(
+                    "expected a margin in m from 0 to 5, got {}",
+                    s.min_reach_margin
+                ),
+            ));
+        }
+        let t = &f.tool_table;
+        coord("tool_table", "position", &t.position)?;
+        size("tool_table", "size", &t.size, 10.0)?;
+        size("tool_table", "leg_height", &[t.leg_height], 5.0)?;
+        size("floor", "size", &f.floor.size, 1000.0)?;
+        coord("floor", "z", &[f.floor.z])?;
+
+        // Payload: the tool alone must not exceed it (the lumber comes on top; the executor checks).
+        if let Some(payload) = robot.meta.payload
+            && tool.mass > payload
+        {
+            return Err(bad(
+                "tool",
+                "model",
+                format!(
+                    "the tool weighs {:.1} kg, more than the robot's payload of {payload:.1} kg",
+                    tool.mass
+                ),
+            ));
+        }
+
+        let belt = |pos: [f64; 3], dir_deg: f64| {
+            Isometry3::from_parts(
+                Translation3::from(Vector3::from(pos)),
+                UnitQuaternion::from_euler_angles(0.0, 0.0, dir_deg.to_radians()),
+            )
+        };
+        let conveyor1 = Conveyor {
+            pose: belt(c1.position, c1.direction_deg),
+            length: c1.length,
+            width: c1.width,
+            speed: c1.speed,
+        };
+        let conveyor2 = Conveyor {
+            pose: belt(c2.position, c2.direction_deg),
+            length: c2.length,
+            width: c2.width,
+            speed: c2.speed,
+        };
+        let face = conveyor2.downstream_end();
+        let dir = conveyor2.direction();
+        let touch_sensor = TouchSensor {
+            pose: Isometry3::from_parts(
+                Translation3::from(
+                    face.coords + dir * (s.size[0] / 2.0) + Vector3::z() * (s.size[2] / 2.0),
+                ),
+                conveyor2.pose.rotation,
+            ),
+            size: s.size,
+            face,
+        };
+        let mut cell = Cell {
+            name: f.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map_or("cell".into(), |s| s.to_string_lossy().into_owned())
+            }),
+            description: f.description,
+            source: path.to_path_buf(),
+            robot,
+            robot_base: Isometry3::from_parts(
+                Translation3::from(Vector3::from(f.robot.base_position)),
+                UnitQuaternion::from_euler_angles(0.0, 0.0, f.robot.base_yaw_deg.to_radians()),
+            ),
+            tool,
+            assembly: Assembly {
+                offset_x: a.offset_x,
+                orientation: a.orientation,
+                centre_y: a.centre_y,
+                surface_z: a.surface_z,
+            },
+            conveyor1,
+            conveyor2,
+            lumber_gap: c1.lumber_gap,
+            touch_sensor,
+            pick: Pick {
+                point: face - dir * s.pick_offset,
+                offset: s.pick_offset,
+                margins: vec![],
+                min_reach_margin: s.min_reach_margin,
+            },
+            tool_table: ToolTable {
+                top_centre: Point3::new(
+                    t.position[0],
+                    t.position[1],
+                    t.position[2] + t.leg_height + t.size[2],
+                ),
+                size: t.size,
+                leg_height: t.leg_height,
+            },
+            floor: Floor {
+                size: f.floor.size,
+                z: f.floor.z,
+            },
+        };
+        cell.check_pick(&s.pick_heights)
+            .map_err(|m| bad("touch_sensor", "pick_offset", m))?;
+        Ok(cell)
+    }
+
+    /// The pick point must be reachable, with the grip TCP, for every checked lumber height,
+    /// with at least `min_reach_margin` of reach to spare.
+    fn check_pick(&mut self, heights: &[f64]) -> Result<(), String> {
+        let tcp = *self
+            .tool
+            .tcp("grip")
+            .ok_or("the tool has no `grip` TCP to pick with")?;
+        let home = self.robot.home();
+        let mut margins = vec![];
+        for &h in heights {
+            let pose = self.to_robot(&self.pick_pose(h));
+            let p = pose.translation.vector;
+            let at = format!(
+                "pick point ({:.3}, {:.3}, {:.3}) m in the robot frame (lumber height {h} m)",
+                p.x, p.y, p.z
+            );
+            if let Err(fail) = self.robot.ik(&pose, &tcp, &home) {
+                return Err(match fail {
+                    IkFailure::OutOfReach {
+                        distance, reach, ..
+                    } => format!(
+                        "{at} is out of reach: wrist centre {distance:.3} m from the shoulder, reach {reach:.3} m; move the conveyor or the robot"
+                    ),
+                    other => format!("{at} is not reachable: {other}"),
+                });
+            }
+            if let Some(margin) = self.robot.reach_margin(&pose, &tcp) {
+                if margin < self.pick.min_reach_margin {
+                    return Err(format!(
+                        "{at} is reachable with only {margin:.3} m to spare; at least {:.3} m (touch_sensor.min_reach_margin) is required",
+                        self.pick.min_reach_margin
+                    ));
+                }
+                margins.push((h, margin));
+            }
+        }
+        self.pick.margins = margins;
+        Ok(())
+    }
+}

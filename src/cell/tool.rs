@@ -1,0 +1,319 @@
+//! End effectors (`robots/tools/*.toml`): rigid parts with primitive shapes and masses in the
+//! robot's `tool0` frame, named TCP frames (`grip`, `nail`) and the gripper's opening.
+
+use super::builtin;
+use super::error::CellError;
+use super::load::looks_like_path;
+use super::shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};
+use super::toml_file;
+use nalgebra::{Isometry3, Vector3};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ToolFile {
+    name: Option<String>,
+    description: Option<String>,
+    tcp: BTreeMap<String, FrameFile>,
+    gripper: Option<GripperFile>,
+    parts: Vec<PartFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameFile {
+    position: [f64; 3],
+    #[serde(default)]
+    rpy_deg: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GripperFile {
+    count: u32,
+    spacing: f64,
+    stroke: f64,
+    open_width: f64,
+    closed_width: f64,
+    jaw_depth: f64,
+    max_lumber: String,
+    max_lumber_section: [f64; 2],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PartFile {
+    name: String,
+    mass: f64,
+    position: [f64; 3],
+    #[serde(default)]
+    rpy_deg: [f64; 3],
+    geometry: GeometryFile,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+enum GeometryFile {
+    Box { size: [f64; 3] },
+    Cylinder { radius: f64, length: f64 },
+    Capsule { radius: f64, length: f64 },
+    Sphere { radius: f64 },
+}
+
+/// One rigid part of a tool.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ToolPart {
+    pub name: String,
+    /// kg
+    pub mass: f64,
+    /// Shape placed in tool0.
+    pub shape: PlacedShape,
+}
+
+/// Parallel grippers of a tool (all lengths in m).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Gripper {
+    pub count: u32,
+    /// Distance between gripper centres along the lumber's long axis.
+    pub spacing: f64,
+    /// Travel of each jaw.
+    pub stroke: f64,
+    pub open_width: f64,
+    pub closed_width: f64,
+    pub jaw_depth: f64,
+    /// Trade name of the widest lumber taken, e.g. "2x6".
+    pub max_lumber: String,
+    /// Thickness and width of that lumber.
+    pub max_lumber_section: [f64; 2],
+}
+
+impl Gripper {
+    /// Whether a lumber cross-section (any way up) fits between the open jaws and is held
+    /// when they close.
+    pub fn takes(&self, thickness: f64, width: f64) -> bool {
+        let (small, large) = (thickness.min(width), thickness.max(width));
+        small >= self.closed_width && large <= self.open_width
+    }
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Tool {
+    pub name: String,
+    pub description: Option<String>,
+    pub parts: Vec<ToolPart>,
+    /// TCP frames in tool0, by name.
+    #[serde(serialize_with = "serialize_frames")]
+    pub tcps: BTreeMap<String, Isometry3<f64>>,
+    pub gripper: Option<Gripper>,
+    /// Total mass, kg.
+    pub mass: f64,
+    /// Centre of mass in tool0, m (part shapes' centres weighted by part masses).
+    pub centre_of_mass: [f64; 3],
+}
+
+fn serialize_frames<S: serde::Serializer>(
+    frames: &BTreeMap<String, Isometry3<f64>>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut map = s.serialize_map(Some(frames.len()))?;
+    for (k, v) in frames {
+        map.serialize_entry(k, &super::matrix_rows(v))?;
+    }
+    map.end()
+}
+
+impl Tool {
+    /// A built-in tool (`study-gripper-nailer`) or a tool TOML file.
+    pub fn load(name_or_path: &str) -> Result<Tool, CellError> {
+        if let Some(&(_, file, text)) = builtin::TOOLS.iter().find(|t| t.0 == name_or_path) {
+            return Tool::parse(Path::new(file), text);
+        }
+        if !looks_like_path(name_or_path) && !Path::new(name_or_path).exists() {
+            return Err(CellError::UnknownName {
+                what: "tool",
+                name: name_or_path.to_string(),
+                known: builtin::tool_names().join(", "),
+            });
+        }
+        let path = Path::new(name_or_path);
+        let text = std::fs::read_to_string(path).map_err(|source| CellError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Tool::parse(path, &text)
+    }
+
+    /// The study's end effector.
+    pub fn study() -> Tool {
+        Tool::load("study-gripper-nailer").expect("the built-in tool parses")
+    }
+
+    /// TCP frame in tool0.
+    pub fn tcp(&self, name: &str) -> Option<&Isometry3<f64>> {
+        self.tcps.get(name)
+    }
+
+    pub fn parse(path: &Path, text: &str) -> Result<Tool, CellError> {
+        let file: ToolFile = toml_file::parse(path, text)?;
+        let bad = |section: &str, key: &str, msg: String| {
+            toml_file::value_error(path, text, section, key, msg)
+        };
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        let sane_len = |v: f64| v.is_finite() && v.abs() <= 10.0;
+        let mut tcps = BTreeMap::new();
+        for (name, f) in &file.tcp {
+            if !(f.position.iter().all(|v| sane_len(*v)) && f.rpy_deg.iter().all(|v| v.is_finite()))
+            {
+                return Err(bad(
+                    &format!("tcp.{name}"),
+                    "position",
+                    "expected finite numbers within 10 m".into(),
+                ));
+            }
+            tcps.insert(
+                name.clone(),
+                isometry_from_xyz_rpy(f.position, f.rpy_deg.map(f64::to_radians)),
+            );
+        }
+        if file.parts.is_empty() {
+            return Err(bad(
+                "",
+                "parts",
+                "a tool needs at least one [[parts]] entry".into(),
+            ));
+        }
+        let mut parts = vec![];
+        let mut mass = 0.0;
+        let mut moment = Vector3::zeros();
+        for p in &file.parts {
+            let section = "parts";
+            if !(p.mass.is_finite() && p.mass >= 0.0 && p.mass <= 1000.0) {
+                return Err(bad(
+                    section,
+                    "mass",
+                    format!(
+                        "part `{}`: expected a mass in kg between 0 and 1000, got {}",
+                        p.name, p.mass
+                    ),
+                ));
+            }
+            if !p.position.iter().all(|v| sane_len(*v)) {
+                return Err(bad(
+                    section,
+                    "position",
+                    format!("part `{}`: expected finite numbers within 10 m", p.name),
+                ));
+            }
+            let shape = match p.geometry {
+                GeometryFile::Box { size } if size.iter().all(|v| positive(*v) && *v <= 10.0) => {
+                    Shape::Box {
+                        half_extents: size.map(|v| v / 2.0),
+                    }
+                }
+                GeometryFile::Cylinder { radius, length }
+                    if positive(radius) && positive(length) && radius <= 5.0 && length <= 10.0 =>
+                {
+                    Shape::Cylinder { radius, length }
+                }
+                GeometryFile::Capsule { radius, length }
+                    if positive(radius) && positive(length) && radius <= 5.0 && length <= 10.0 =>
+                {
+                    Shape::Capsule { radius, length }
+                }
+                GeometryFile::Sphere { radius } if positive(radius) && radius <= 5.0 => {
+                    Shape::Sphere { radius }
+                }
+                _ => {
+                    return Err(bad(
+                        section,
+                        "geometry",
+                        format!("part `{}`: sizes must be positive and at most 10 m", p.name),
+                    ));
+                }
+            };
+            let origin = isometry_from_xyz_rpy(p.position, p.rpy_deg.map(f64::to_radians));
+            mass += p.mass;
+            moment += origin.translation.vector * p.mass;
+            parts.push(ToolPart {
+                name: p.name.clone(),
+                mass: p.mass,
+                shape: PlacedShape { origin, shape },
+            });
+        }
+        let gripper = match file.gripper {
+            None => None,
+            Some(g) => {
+                let lengths = [
+                    g.spacing,
+                    g.stroke,
+                    g.open_width,
+                    g.closed_width,
+                    g.jaw_depth,
+                ];
+                if !lengths
+                    .iter()
+                    .chain(&g.max_lumber_section)
+                    .all(|v| positive(*v) && *v <= 10.0)
+                {
+                    return Err(bad(
+                        "gripper",
+                        "spacing",
+                        "gripper lengths must be positive and at most 10 m".into(),
+                    ));
+                }
+                if g.closed_width >= g.open_width {
+                    return Err(bad(
+                        "gripper",
+                        "closed_width",
+                        format!(
+                            "closed width {} must be smaller than the open width {}",
+                            g.closed_width, g.open_width
+                        ),
+                    ));
+                }
+                let gripper = Gripper {
+                    count: g.count,
+                    spacing: g.spacing,
+                    stroke: g.stroke,
+                    open_width: g.open_width,
+                    closed_width: g.closed_width,
+                    jaw_depth: g.jaw_depth,
+                    max_lumber: g.max_lumber,
+                    max_lumber_section: g.max_lumber_section,
+                };
+                let [t, w] = gripper.max_lumber_section;
+                if !gripper.takes(t, w) {
+                    return Err(bad(
+                        "gripper",
+                        "max_lumber_section",
+                        format!(
+                            "{t} x {w} m does not fit the jaws ({} to {} m)",
+                            gripper.closed_width, gripper.open_width
+                        ),
+                    ));
+                }
+                Some(gripper)
+            }
+        };
+        let com = if mass > 0.0 {
+            moment / mass
+        } else {
+            Vector3::zeros()
+        };
+        Ok(Tool {
+            name: file.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map_or("tool".into(), |s| s.to_string_lossy().into_owned())
+            }),
+            description: file.description,
+            parts,
+            tcps,
+            gripper,
+            mass,
+            centre_of_mass: [com.x, com.y, com.z],
+        })
+    }
+}

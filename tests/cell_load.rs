@@ -1,0 +1,247 @@
+//! The shipped cells and tool load and are consistent; bad cell files are refused with
+//! file:line, the key and what is expected.
+
+use framewright::cell::{Cell, CellError, Orientation, Tool};
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/cells")
+        .join(name)
+}
+
+#[test]
+fn study_cells_load_with_the_study_numbers() {
+    for (name, robot, offset) in [
+        ("study-abb", "abb-irb4600-40-255", 0.531),
+        ("study-kuka", "kuka-kr150-2", 0.70),
+    ] {
+        let cell = Cell::load(name).unwrap();
+        assert_eq!(cell.name, name);
+        assert_eq!(cell.robot.name, robot);
+        assert_eq!(cell.assembly.offset_x, offset);
+        assert_eq!(cell.assembly.orientation, Orientation::Parallel);
+        assert_eq!(cell.assembly.centre_y, 0.0);
+        assert_eq!(cell.conveyor1.speed, 0.05);
+        assert_eq!(cell.conveyor2.speed, 2.0);
+        assert_eq!(cell.lumber_gap, 0.150);
+        // The sensor sits at the downstream end of conveyor 2; the pick point is on that belt.
+        let end = cell.conveyor2.downstream_end();
+        assert!((cell.touch_sensor.face - end).norm() < 1e-12);
+        assert!((cell.pick.point - end).norm() - cell.pick.offset < 1e-12);
+        // Conveyor 1 feeds conveyor 2.
+        assert!((cell.conveyor1.downstream_end() - cell.conveyor2.upstream_end()).norm() < 1e-9);
+        // Picks of 2x4 and 2x6 on edge are reachable with the required margin.
+        assert_eq!(cell.pick.margins.len(), 2);
+        for &(h, margin) in &cell.pick.margins {
+            assert!(
+                margin >= cell.pick.min_reach_margin,
+                "{name}: {h} m lumber: margin {margin}"
+            );
+            let pose = cell.to_robot(&cell.pick_pose(h));
+            let sols = cell
+                .robot
+                .ik(&pose, cell.tool.tcp("grip").unwrap(), &cell.robot.home())
+                .unwrap();
+            let got = cell.robot.fk_tip(&sols[0]) * cell.tool.tcp("grip").unwrap();
+            assert!((got.translation.vector - pose.translation.vector).norm() < 1e-6);
+        }
+        // The tool is lighter than the payload.
+        assert!(cell.tool.mass < cell.robot.meta.payload.unwrap());
+    }
+}
+
+#[test]
+fn cell_loads_from_a_path_too() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/cells/study-kuka.toml");
+    let cell = Cell::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(cell.robot.name, "kuka-kr150-2");
+}
+
+#[test]
+fn study_tool_has_grip_and_nail_frames_and_takes_2x6() {
+    let tool = Tool::study();
+    assert!(tool.tcp("grip").is_some() && tool.tcp("nail").is_some());
+    assert!((tool.mass - 13.5).abs() < 1e-9, "{}", tool.mass);
+    let nailer: f64 = tool
+        .parts
+        .iter()
+        .filter(|p| p.name.starts_with("nailer"))
+        .map(|p| p.mass)
+        .sum();
+    assert!((nailer - 4.0).abs() < 1e-9);
+    let g = tool.gripper.as_ref().unwrap();
+    assert_eq!(g.count, 2);
+    assert!(g.takes(0.038, 0.140), "2x6");
+    assert!(g.takes(0.038, 0.089), "2x4");
+    assert!(!g.takes(0.089, 0.184), "4x8 is too wide");
+    // The nail direction (TCP z) is tool0 +x: nailing does not push the jaws into the work.
+    let nail_z = tool.tcp("nail").unwrap().rotation * nalgebra::Vector3::z();
+    assert!((nail_z - nalgebra::Vector3::x()).norm() < 1e-12);
+}
+
+fn load_error(file: &str) -> String {
+    let err = Cell::load(fixture(file).to_str().unwrap()).unwrap_err();
+    assert!(
+        matches!(err, CellError::Toml { .. } | CellError::Value { .. }),
+        "{err:?}"
+    );
+    err.to_string()
+}
+
+#[test]
+fn unknown_key_names_file_line_and_key() {
+    let msg = load_error("unknown_key.toml");
+    assert!(
+        msg.contains("unknown_key.toml:34:1: key `conveyor1.speeed`"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("speeed") && msg.contains("expected one of"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn wrong_type_names_file_line_and_expected_type() {
+    let msg = load_error("wrong_type.toml");
+    assert!(
+        msg.contains("wrong_type.toml:41:9: key `conveyor2.width`"),
+        "{msg}"
+    );
+    assert!(msg.contains("expected f64"), "{msg}");
+}
+
+#[test]
+fn unreachable_pick_point_is_refused() {
+    let msg = load_error("unreachable_pick.toml");
+    assert!(msg.contains("unreachable_pick.toml:"), "{msg}");
+    assert!(
+        msg.contains("touch_sensor.pick_offset") && msg.contains("out of reach"),
+        "{msg}"
+    );
+    assert!(msg.contains("reach 2.377"), "{msg}");
+}
+
+#[test]
+fn tool_heavier_than_payload_is_refused() {
+    let msg = load_error("heavy_tool_cell.toml");
+    assert!(
+        msg.contains("heavy_tool_cell.toml:15: key `tool.model`"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("50.5 kg") && msg.contains("payload of 40.0 kg"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn negative_speed_is_refused() {
+    let msg = load_error("negative_speed.toml");
+    assert!(
+        msg.contains("negative_speed.toml:42: key `conveyor2.speed`"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn unknown_robot_is_refused_at_its_line() {
+    let msg = load_error("unknown_robot.toml");
+    assert!(
+        msg.contains("unknown_robot.toml:10: key `robot.model`"),
+        "{msg}"
+    );
+    assert!(msg.contains("abb-irb4600-40-255"), "{msg}");
+}
+
+#[test]
+fn unknown_cell_name_lists_the_built_ins() {
+    let msg = Cell::load("study-fanuc").unwrap_err().to_string();
+    assert!(
+        msg.contains("study-abb") && msg.contains("study-kuka"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn study_layout_reproduces_the_unreachable_top_plate() {
+    // An 8 ft (2.44 m) wall laid flat from assembly.offset_x: the middle of a stud is within
+    // reach, the top plate (2x4 on edge, grip TCP pointing down on its top face) is not — as in
+    // the study.
+    for name in ["study-abb", "study-kuka"] {
+        let cell = Cell::load(name).unwrap();
+        let grip = *cell.tool.tcp("grip").unwrap();
+        let down = |x: f64| {
+            nalgebra::Isometry3::from_parts(
+                nalgebra::Translation3::new(x, 0.0, 0.089),
+                nalgebra::UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.0),
+            )
+        };
+        let middle = cell.assembly.offset_x + 1.22;
+        let top = cell.assembly.offset_x + 2.44 - 0.019;
+        assert!(
+            cell.robot
+                .ik(&cell.to_robot(&down(middle)), &grip, &cell.robot.home())
+                .is_ok(),
+            "{name}"
+        );
+        match cell
+            .robot
+            .ik(&cell.to_robot(&down(top)), &grip, &cell.robot.home())
+        {
+            Err(framewright::cell::IkFailure::OutOfReach {
+                distance, reach, ..
+            }) => assert!(distance > reach),
+            other => panic!("{name}: top plate at x = {top}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn wall_laid_flat_follows_the_assembly_keys() {
+    use nalgebra::{Point3, Vector3};
+    let cell = Cell::load("study-abb").unwrap();
+    let (length, height) = (6.86, 2.44);
+    let t = cell.assembly.wall_to_cell(length, height);
+    // Parallel: the wall's bottom edge at x = 0.531, its top at x = 0.531 + height, centred on y = 0.
+    let bottom_start = t * Point3::new(0.0, 0.0, 0.0);
+    let top_end = t * Point3::new(length, height, 0.0);
+    assert!(
+        (bottom_start - Point3::new(0.531, 3.43, 0.0)).norm() < 1e-12,
+        "{bottom_start}"
+    );
+    assert!(
+        (top_end - Point3::new(0.531 + 2.44, -3.43, 0.0)).norm() < 1e-12,
+        "{top_end}"
+    );
+    // w (across the thickness) points up: the outer face lies on the floor.
+    assert!((t.rotation * Vector3::z() - Vector3::z()).norm() < 1e-12);
+    // Perpendicular: the length runs along +x from offset_x, the height centred on y.
+    let mut perpendicular = cell.assembly;
+    perpendicular.orientation = Orientation::Perpendicular;
+    let t = perpendicular.wall_to_cell(length, height);
+    let p = t * Point3::new(length, height, 0.089);
+    assert!(
+        (p - Point3::new(0.531 + 6.86, 1.22, 0.089)).norm() < 1e-12,
+        "{p}"
+    );
+}
+
+#[test]
+fn pick_without_enough_margin_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/cells/study-abb.toml"),
+    )
+    .unwrap()
+    .replace("min_reach_margin = 0.10", "min_reach_margin = 1.50");
+    let file = dir.path().join("tight.toml");
+    std::fs::write(&file, text).unwrap();
+    let msg = Cell::load(file.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        msg.contains("key `touch_sensor.pick_offset`")
+            && msg.contains("to spare; at least 1.500 m"),
+        "{msg}"
+    );
+}
