@@ -3,7 +3,10 @@
 //! generates from benches/logic/tc.dl vs a hand-written ascent program.
 //! All "end-to-end" variants take `Value` tuples in and return sorted `Value` tuples.
 
-use criterion::{criterion_group, criterion_main, Criterion};
+// Ascent programs are filled field by field after `default()`.
+#![allow(clippy::field_reassign_with_default)]
+
+use criterion::{Criterion, criterion_group, criterion_main};
 use framewright::logic::compiled::{self, Relations};
 use framewright::logic::{Engine, Options, Origin, Program, Value};
 use std::sync::Arc;
@@ -18,17 +21,31 @@ ascent::ascent! {
 
 fn chains(n: i64, chain: i64) -> Vec<(i64, i64)> {
     let per = chain + 1;
-    (0..n / chain).flat_map(|c| (1..per).map(move |k| (c * per + k - 1, c * per + k))).collect()
+    (0..n / chain)
+        .flat_map(|c| (1..per).map(move |k| (c * per + k - 1, c * per + k)))
+        .collect()
 }
 
 fn bench(c: &mut Criterion) {
     let edges = chains(100_000, 10);
-    let vals: Vec<Vec<Value>> = edges.iter().map(|&(a, b)| vec![Value::Number(a), Value::Number(b)]).collect();
-    let program = Arc::new(Program::parse_files(&[concat!(env!("CARGO_MANIFEST_DIR"), "/benches/logic/tc.dl")]).unwrap());
+    let vals: Vec<Vec<Value>> = edges
+        .iter()
+        .map(|&(a, b)| vec![Value::Number(a), Value::Number(b)])
+        .collect();
+    let program = Arc::new(
+        Program::parse_files(&[concat!(env!("CARGO_MANIFEST_DIR"), "/benches/logic/tc.dl")])
+            .unwrap(),
+    );
     let edb: Relations = [("edge".to_string(), vals.clone())].into();
     let run = compiled::program("benches/logic/tc.dl").expect("compiled by build.rs");
     let interp = |provenance: bool| {
-        let mut e = Engine::new(program.clone(), Options { provenance, ..Options::default() });
+        let mut e = Engine::new(
+            program.clone(),
+            Options {
+                provenance,
+                ..Options::default()
+            },
+        );
         for t in &vals {
             e.insert("edge", t.clone(), Origin::Rust).unwrap();
         }
@@ -62,9 +79,16 @@ fn bench(c: &mut Criterion) {
     g.bench_function("handwritten_ascent_values", |b| {
         b.iter(|| {
             let mut p = HandTc::default();
-            p.edge = vals.iter().map(|t| (t[0].as_number().unwrap(), t[1].as_number().unwrap())).collect();
+            p.edge = vals
+                .iter()
+                .map(|t| (t[0].as_number().unwrap(), t[1].as_number().unwrap()))
+                .collect();
             p.run();
-            let mut out: Vec<Vec<Value>> = p.path.iter().map(|t| vec![Value::Number(t.0), Value::Number(t.1)]).collect();
+            let mut out: Vec<Vec<Value>> = p
+                .path
+                .iter()
+                .map(|t| vec![Value::Number(t.0), Value::Number(t.1)])
+                .collect();
             out.sort();
             out.len()
         })

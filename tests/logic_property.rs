@@ -63,7 +63,13 @@ fn gen_program(seed: u64) -> (Vec<Rule>, Vec<(usize, i64, i64)>, usize) {
             let candidates: Vec<usize> = (0..n_rel).filter(|&r| level(r) <= level(head)).collect();
             let r = candidates[rng.next(candidates.len())];
             let args: Vec<Term> = (0..arity(r))
-                .map(|_| if rng.next(6) == 0 { Term::Const(rng.next(DOMAIN as usize) as i64) } else { Term::Var(rng.next(VARS.len())) })
+                .map(|_| {
+                    if rng.next(6) == 0 {
+                        Term::Const(rng.next(DOMAIN as usize) as i64)
+                    } else {
+                        Term::Var(rng.next(VARS.len()))
+                    }
+                })
                 .collect();
             for a in &args {
                 if let Term::Var(v) = a {
@@ -80,19 +86,41 @@ fn gen_program(seed: u64) -> (Vec<Rule>, Vec<(usize, i64, i64)>, usize) {
             let lower: Vec<usize> = (0..n_rel).filter(|&r| level(r) < level(head)).collect();
             if !lower.is_empty() {
                 let r = lower[rng.next(lower.len())];
-                let args = (0..arity(r)).map(|_| Term::Var(bound[rng.next(bound.len())])).collect();
+                let args = (0..arity(r))
+                    .map(|_| Term::Var(bound[rng.next(bound.len())]))
+                    .collect();
                 body.push(Lit::Neg(r, args));
             }
         }
         match rng.next(4) {
-            0 => body.push(Lit::Less(bound[rng.next(bound.len())], bound[rng.next(bound.len())])),
-            1 => body.push(Lit::NotEq(bound[rng.next(bound.len())], bound[rng.next(bound.len())])),
+            0 => body.push(Lit::Less(
+                bound[rng.next(bound.len())],
+                bound[rng.next(bound.len())],
+            )),
+            1 => body.push(Lit::NotEq(
+                bound[rng.next(bound.len())],
+                bound[rng.next(bound.len())],
+            )),
             _ => {}
         }
-        let head_vars = (0..arity(head)).map(|_| bound[rng.next(bound.len())]).collect();
-        rules.push(Rule { head, head_vars, body });
+        let head_vars = (0..arity(head))
+            .map(|_| bound[rng.next(bound.len())])
+            .collect();
+        rules.push(Rule {
+            head,
+            head_vars,
+            body,
+        });
     }
-    let facts = (0..rng.next(10) + 2).map(|_| (rng.next(2), rng.next(DOMAIN as usize) as i64, rng.next(DOMAIN as usize) as i64)).collect();
+    let facts = (0..rng.next(10) + 2)
+        .map(|_| {
+            (
+                rng.next(2),
+                rng.next(DOMAIN as usize) as i64,
+                rng.next(DOMAIN as usize) as i64,
+            )
+        })
+        .collect();
     (rules, facts, n_rel)
 }
 
@@ -115,13 +143,24 @@ fn program_text(rules: &[Rule], n_rel: usize) -> String {
             .body
             .iter()
             .map(|l| match l {
-                Lit::Pos(r, a) => format!("r{r}({})", a.iter().map(term_text).collect::<Vec<_>>().join(", ")),
-                Lit::Neg(r, a) => format!("!r{r}({})", a.iter().map(term_text).collect::<Vec<_>>().join(", ")),
+                Lit::Pos(r, a) => format!(
+                    "r{r}({})",
+                    a.iter().map(term_text).collect::<Vec<_>>().join(", ")
+                ),
+                Lit::Neg(r, a) => format!(
+                    "!r{r}({})",
+                    a.iter().map(term_text).collect::<Vec<_>>().join(", ")
+                ),
                 Lit::Less(a, b) => format!("{} < {}", VARS[*a], VARS[*b]),
                 Lit::NotEq(a, b) => format!("{} != {}", VARS[*a], VARS[*b]),
             })
             .collect();
-        s.push_str(&format!("r{}({}) :- {}.\n", rule.head, head.join(", "), body.join(", ")));
+        s.push_str(&format!(
+            "r{}({}) :- {}.\n",
+            rule.head,
+            head.join(", "),
+            body.join(", ")
+        ));
     }
     s
 }
@@ -138,14 +177,18 @@ fn naive(rules: &[Rule], facts: &[(usize, i64, i64)], n_rel: usize) -> Vec<BTree
             let mut new = Vec::new();
             for rule in rules.iter().filter(|r| level(r.head) == lv) {
                 for code in 0..DOMAIN.pow(VARS.len() as u32) {
-                    let env: Vec<i64> = (0..VARS.len()).map(|i| (code / DOMAIN.pow(i as u32)) % DOMAIN).collect();
+                    let env: Vec<i64> = (0..VARS.len())
+                        .map(|i| (code / DOMAIN.pow(i as u32)) % DOMAIN)
+                        .collect();
                     let val = |t: &Term| match t {
                         Term::Var(v) => env[*v],
                         Term::Const(c) => *c,
                     };
                     let holds = rule.body.iter().all(|l| match l {
                         Lit::Pos(r, a) => rels[*r].contains(&a.iter().map(val).collect::<Vec<_>>()),
-                        Lit::Neg(r, a) => !rels[*r].contains(&a.iter().map(val).collect::<Vec<_>>()),
+                        Lit::Neg(r, a) => {
+                            !rels[*r].contains(&a.iter().map(val).collect::<Vec<_>>())
+                        }
                         Lit::Less(a, b) => env[*a] < env[*b],
                         Lit::NotEq(a, b) => env[*a] != env[*b],
                     });
