@@ -52,6 +52,8 @@ pub enum CStep {
         /// Index position on `rel` for the bound columns (None: no column bound).
         index: Option<usize>,
         key: Vec<CExpr>,
+        /// `key` when it is only variables (the fast path).
+        key_slots: Option<Vec<u32>>,
         binds: Vec<(usize, u32)>,
         checks: Vec<(usize, CExpr)>,
         range: Range,
@@ -210,9 +212,17 @@ fn compile_steps(
                 } else {
                     Some(rels[rel].ensure_index(&key_cols))
                 };
+                let key_slots = key
+                    .iter()
+                    .map(|e| match e {
+                        CExpr::Slot(s) => Some(*s),
+                        _ => None,
+                    })
+                    .collect::<Option<Vec<u32>>>();
                 out.push(CStep::Scan {
                     rel,
                     index,
+                    key_slots,
                     key,
                     binds,
                     checks,

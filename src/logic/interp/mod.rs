@@ -238,33 +238,28 @@ impl Engine {
         }
         let mut iteration = 0usize;
         loop {
-            let mut produced: Vec<(usize, Vec<Value>, Vec<RecordedBody>)> = Vec::new();
+            let mut produced: Vec<(usize, Relation, Vec<RecordedBody>)> = Vec::new();
             for rule in rules {
                 if iteration > 0 && !rule.recursive {
                     continue;
                 }
-                let (vals, provs) = self.eval_rule(rule, &lim)?;
-                if !vals.is_empty() || (self.rels[rule.head_rel].arity == 0 && !provs.is_empty()) {
-                    produced.push((rule.id, vals, provs));
+                let (pending, provs) = self.eval_rule(rule, &lim)?;
+                if !pending.is_empty() {
+                    produced.push((rule.id, pending, provs));
                 }
             }
             let mut grew = false;
             let mut best: Option<(usize, usize)> = None;
-            for (rule_id, vals, provs) in produced {
+            for (rule_id, pending, provs) in produced {
                 let head = self.program.rel_index[&self.program.rules[rule_id].head.rel];
-                let arity = self.rels[head].arity;
-                let n = vals.len().checked_div(arity).unwrap_or(provs.len());
                 let mut added = 0usize;
-                for k in 0..n {
-                    let t = if arity == 0 {
-                        &[][..]
-                    } else {
-                        &vals[k * arity..(k + 1) * arity]
-                    };
+                for k in 0..pending.len() {
+                    let t = pending.tuple(k as u32);
                     if self.rels[head].insert(t).is_some() {
                         added += 1;
-                        if let Some(p) = &mut self.prov {
-                            let (rule, body) = provs[k].clone();
+                        if let (Some(p), Some((rule, body))) =
+                            (&mut self.prov, provs.get(k).cloned())
+                        {
                             let height = 1 + body
                                 .iter()
                                 .map(|&(r, id)| prov_height(&p[r as usize][id as usize]))
@@ -336,11 +331,13 @@ impl Engine {
         &self,
         rule: &CRule,
         lim: &[(u32, u32)],
-    ) -> Result<(Vec<Value>, Vec<(u32, Box<[(u32, u32)]>)>), LogicError> {
-        let mut out: Vec<Value> = Vec::new();
-        let mut provs: Vec<(u32, Box<[(u32, u32)]>)> = Vec::new();
+    ) -> Result<(Relation, Vec<RecordedBody>), LogicError> {
+        // New tuples are collected in a set of their own: a join can derive the
+        // same tuple millions of times within one iteration.
         let head_rel = &self.rels[rule.head_rel];
-        let want_prov = self.prov.is_some() || head_rel.arity == 0;
+        let mut pending = Relation::new(head_rel.arity);
+        let mut provs: Vec<RecordedBody> = Vec::new();
+        let want_prov = self.prov.is_some();
         let mut env = vec![Value::Number(0); rule.slot_names.len()];
         let mut ex = Exec {
             rels: &self.rels,
@@ -354,18 +351,16 @@ impl Engine {
                 for e in &rule.head {
                     tuple.push(eval::eval(e, env)?);
                 }
-                if head_rel.find(&tuple).is_none() {
-                    out.extend(tuple.iter().cloned());
-                    if want_prov {
-                        provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));
-                    }
+                if head_rel.find(&tuple).is_none() && pending.insert(&tuple).is_some() && want_prov
+                {
+                    provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));
                 }
                 Ok(())
             };
             ex.run(steps, &mut env, &mut emit)
                 .map_err(|msg| self.runtime_error(rule, &env, msg))?;
         }
-        Ok((out, provs))
+        Ok((pending, provs))
     }
 
     fn runtime_error(&self, rule: &CRule, env: &[Value], message: String) -> LogicError {
@@ -447,6 +442,7 @@ impl<'a> Exec<'a> {
                 rel,
                 index,
                 key,
+                key_slots,
                 binds,
                 checks,
                 range,
@@ -466,6 +462,27 @@ impl<'a> Exec<'a> {
                     None => {
                         for id in lo..hi {
                             self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                        }
+                    }
+                    Some(ix) if key_slots.is_some() => {
+                        // Common case: the key is made of bound variables; no allocation.
+                        let slots = key_slots.as_deref().unwrap_or_default();
+                        let index = &r.indexes[*ix];
+                        let ids = index.get(hash_values(slots.iter().map(|&s| &env[s as usize])));
+                        let start = ids.partition_point(|&i| i < lo);
+                        for &id in &ids[start..] {
+                            if id >= hi {
+                                break;
+                            }
+                            let t = r.tuple(id);
+                            if index
+                                .cols
+                                .iter()
+                                .zip(slots)
+                                .all(|(&c, &s)| t[c] == env[s as usize])
+                            {
+                                self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                            }
                         }
                     }
                     Some(ix) => {
