@@ -21,6 +21,8 @@ struct Cli {
 enum Command {
     /// Read an IFC model and list its lumber pieces.
     Inspect(cli::inspect::InspectArgs),
+    /// Infer walls, member roles, assembly order, nailing and framing targets.
+    Plan(cli::plan::PlanArgs),
     /// Run or check a rule program (a subset of Soufflé's Datalog).
     #[command(subcommand)]
     Rules(cli::rules::RulesCommand),
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Inspect(args) => cli::inspect::run(args),
+        Command::Plan(args) => cli::plan::run(args),
         Command::Rules(cmd) => cli::rules::run(cmd),
         Command::Robot(cmd) => cli::robot::run(cmd),
         Command::Synth(args) => cli::synth::run(args),

@@ -2,6 +2,7 @@
 //! message shown to the user and the exit code (2 = bad input).
 
 pub mod inspect;
+pub mod plan;
 pub mod robot;
 pub mod rules;
 pub mod synth;

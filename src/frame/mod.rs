@@ -3,6 +3,7 @@
 //! runs the same rules for `--rules-dir`, user rules and provenance.
 
 pub mod facts;
+pub mod plan;
 
 use crate::ifc::Model;
 use crate::logic::compiled::{self, Relations};

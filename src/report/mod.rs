@@ -2,6 +2,7 @@
 //! nanometre so that output is stable and free of float noise.
 
 pub mod inspect;
+pub mod plan;
 
 /// Rounds a length to 1e-9 m (and turns -0 into 0).
 pub fn round_m(x: f64) -> f64 {
