@@ -1,5 +1,5 @@
-//! Compiles the rule programs `rules/*.dl` (built-in rule base),
-//! `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
+//! Compiles the built-in rule base (all `rules/*.dl` as one program, entry
+//! `"rules"`) and each `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
 //! using the same parser and checker as the interpreter.
 
 use std::fmt::Write as _;
@@ -74,14 +74,39 @@ fn main() {
     let mut table = Vec::new();
     for dir in ["rules", "tests/logic", "benches/logic"] {
         println!("cargo:rerun-if-changed={dir}");
-        let abs = root.join(dir);
         // Included fragments live in subdirectories; watch them too.
-        if let Ok(rd) = std::fs::read_dir(&abs) {
+        if let Ok(rd) = std::fs::read_dir(root.join(dir)) {
             for e in rd.flatten() {
                 println!("cargo:rerun-if-changed={}", e.path().display());
             }
         }
-        for file in dl_files(&abs) {
+    }
+    // The built-in rule base: all rules/*.dl form one program, also embedded
+    // as text so the interpreter can run it (explanations) without the sources.
+    let builtin = dl_files(&root.join("rules"));
+    out.push_str("/// The built-in rule base: (path, text) of every `rules/*.dl`.\n");
+    out.push_str("pub static BUILTIN_SOURCES: &[(&str, &str)] = &[\n");
+    for f in &builtin {
+        let name = format!("rules/{}", f.file_name().unwrap().to_string_lossy());
+        let _ = writeln!(
+            out,
+            "    ({name:?}, include_str!({:?})),",
+            f.display().to_string()
+        );
+    }
+    out.push_str("];\n");
+    if !builtin.is_empty() {
+        let program = front::load_files(&builtin, SIGS)
+            .unwrap_or_else(|e| panic!("the built-in rules do not check:\n{e}"));
+        match front::codegen::generate(&program, "builtin_rules") {
+            Ok(code) => out.push_str(&code),
+            Err(e) => panic!("the built-in rules cannot be compiled to ascent: {e}"),
+        }
+        table.push(("rules".to_string(), "builtin_rules".to_string()));
+    }
+    // Test and benchmark programs: one program per file.
+    for dir in ["tests/logic", "benches/logic"] {
+        for file in dl_files(&root.join(dir)) {
             let rel = format!("{dir}/{}", file.file_name().unwrap().to_string_lossy());
             let program = match front::load_files(std::slice::from_ref(&file), SIGS) {
                 Ok(p) => p,

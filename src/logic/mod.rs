@@ -33,6 +33,12 @@ impl Program {
         front::load_files(&paths, &functors::signatures())
     }
 
+    /// The built-in rule base (`rules/*.dl`, embedded at build time) as one
+    /// checked program; its compiled form is `compiled::program("rules")`.
+    pub fn builtin() -> Result<Program, Diagnostics> {
+        front::load_sources(compiled::BUILTIN_SOURCES, &functors::signatures())
+    }
+
     /// Parse and check program text; `name` is used in error messages.
     pub fn parse_str(name: &str, text: &str) -> Result<Program, Diagnostics> {
         front::load_str(name, text, &functors::signatures())

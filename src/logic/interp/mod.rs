@@ -351,7 +351,10 @@ impl Engine {
                 for e in &rule.head {
                     tuple.push(eval::eval(e, env)?);
                 }
-                if head_rel.find(&tuple).is_none() && pending.insert(&tuple).is_some() && want_prov
+                let h = hash_values(tuple.iter());
+                if head_rel.find_hashed(&tuple, h).is_none()
+                    && pending.insert_hashed(&tuple, h).is_some()
+                    && want_prov
                 {
                     provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));
                 }
