@@ -239,6 +239,22 @@ impl Engine {
         let mut iteration = 0usize;
         loop {
             let mut produced: Vec<(usize, Relation, Vec<RecordedBody>)> = Vec::new();
+            if !self.program.strata[si].recursive {
+                // No rule of the stratum reads its relation: derive straight into it.
+                let head = members[0];
+                let mut target = std::mem::replace(&mut self.rels[head], Relation::new(0));
+                let mut target_prov = self.prov.as_mut().map(|p| std::mem::take(&mut p[head]));
+                let result = rules.iter().try_for_each(|rule| {
+                    self.eval_rule_into(rule, &lim, &mut target, target_prov.as_mut())
+                });
+                self.rels[head] = target;
+                if let (Some(p), Some(tp)) = (&mut self.prov, target_prov) {
+                    p[head] = tp;
+                }
+                result?;
+                stats.iterations += 1;
+                return self.check_tuple_limit(si, rules, None, 0);
+            }
             for rule in rules {
                 if iteration > 0 && !rule.recursive {
                     continue;
@@ -276,21 +292,7 @@ impl Engine {
                     }
                 }
             }
-            let total: usize = self.rels.iter().map(Relation::len).sum();
-            if total > self.options.limits.max_tuples {
-                let rule = best.map(|(r, _)| r).unwrap_or(rules[0].id);
-                return Err(LogicError::Limit {
-                    message: format!(
-                        "more than {} tuples (limit) after {} iteration(s) of the stratum of {}; rule {} `{}` keeps adding tuples",
-                        self.options.limits.max_tuples,
-                        iteration + 1,
-                        self.stratum_names(si),
-                        self.program.rule_name(rule),
-                        self.program.rules[rule]
-                    ),
-                    hint: "a rule that computes new values from its own output (e.g. `n(x+1) :- n(x).`) never stops; bound it with a condition such as `x < 100`, or raise the limit (--max-tuples)".into(),
-                });
-            }
+            self.check_tuple_limit(si, rules, best.map(|(r, _)| r), iteration)?;
             iteration += 1;
             stats.iterations += 1;
             if !grew || !self.program.strata[si].recursive {
@@ -312,6 +314,78 @@ impl Engine {
             for &m in &members {
                 lim[m] = (lim[m].1, self.rels[m].len() as u32);
             }
+        }
+        Ok(())
+    }
+
+    /// Stop with a clear error once the relations hold more tuples than allowed.
+    fn check_tuple_limit(
+        &self,
+        si: usize,
+        rules: &[CRule],
+        best: Option<usize>,
+        iteration: usize,
+    ) -> Result<(), LogicError> {
+        let total: usize = self.rels.iter().map(Relation::len).sum();
+        if total > self.options.limits.max_tuples {
+            let rule = best.unwrap_or(rules[0].id);
+            return Err(LogicError::Limit {
+                message: format!(
+                    "more than {} tuples (limit) after {} iteration(s) of the stratum of {}; rule {} `{}` keeps adding tuples",
+                    self.options.limits.max_tuples,
+                    iteration + 1,
+                    self.stratum_names(si),
+                    self.program.rule_name(rule),
+                    self.program.rules[rule]
+                ),
+                hint: "a rule that computes new values from its own output (e.g. `n(x+1) :- n(x).`) never stops; bound it with a condition such as `x < 100`, or raise the limit (--max-tuples)".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Evaluate a rule of a non-recursive stratum, inserting into its (taken out) head relation.
+    fn eval_rule_into(
+        &self,
+        rule: &CRule,
+        lim: &[(u32, u32)],
+        head: &mut Relation,
+        mut prov: Option<&mut Vec<Prov>>,
+    ) -> Result<(), LogicError> {
+        let mut env = vec![Value::Number(0); rule.slot_names.len()];
+        let mut ex = Exec {
+            rels: &self.rels,
+            lim,
+            trail: Vec::new(),
+        };
+        let mut tuple = Vec::with_capacity(head.arity);
+        let all_prov = self.prov.as_ref();
+        for steps in &rule.variants {
+            let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
+                tuple.clear();
+                for e in &rule.head {
+                    tuple.push(eval::eval(e, env)?);
+                }
+                let h = hash_values(tuple.iter());
+                if head.insert_hashed(&tuple, h).is_some()
+                    && let (Some(p), Some(all)) = (prov.as_deref_mut(), all_prov)
+                {
+                    let height = 1 + ex
+                        .trail
+                        .iter()
+                        .map(|&(r, id)| prov_height(&all[r as usize][id as usize]))
+                        .max()
+                        .unwrap_or(0);
+                    p.push(Prov::Derived {
+                        rule: rule.id as u32,
+                        body: ex.trail.clone().into_boxed_slice(),
+                        height,
+                    });
+                }
+                Ok(())
+            };
+            ex.run(steps, &mut env, &mut emit)
+                .map_err(|msg| self.runtime_error(rule, &env, msg))?;
         }
         Ok(())
     }
