@@ -479,6 +479,26 @@ impl Engine {
     }
 }
 
+/// Projections of the tuples a scan has followed (see `CStep::Scan::project`).
+pub(crate) struct Seen<'c> {
+    cols: &'c [usize],
+    set: std::collections::HashSet<Vec<Value>, std::hash::BuildHasherDefault<store::FastHasher>>,
+}
+
+impl<'c> Seen<'c> {
+    fn new(cols: &'c [usize]) -> Self {
+        Seen {
+            cols,
+            set: Default::default(),
+        }
+    }
+    /// Whether no earlier tuple had the same projection.
+    fn first(&mut self, t: &[Value]) -> bool {
+        self.set
+            .insert(self.cols.iter().map(|&c| t[c].clone()).collect())
+    }
+}
+
 /// Rule index and the body tuples of one derivation.
 type RecordedBody = (u32, Box<[(u32, u32)]>);
 
@@ -520,11 +540,13 @@ impl<'a> Exec<'a> {
                 index,
                 key,
                 key_slots,
+                project,
                 binds,
                 checks,
                 range,
                 ..
             } => {
+                let mut seen = project.as_deref().map(Seen::new);
                 let r: &'a Relation = &self.rels[*rel];
                 let (old, end) = self.lim[*rel];
                 let (lo, hi) = match range {
@@ -538,7 +560,7 @@ impl<'a> Exec<'a> {
                 match index {
                     None => {
                         for id in lo..hi {
-                            self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                            self.visit(*rel, r, id, binds, checks, &mut seen, rest, env, k)?;
                         }
                     }
                     Some(ix) if key_slots.is_some() => {
@@ -558,7 +580,7 @@ impl<'a> Exec<'a> {
                                 .zip(slots)
                                 .all(|(&c, &s)| t[c] == env[s as usize])
                             {
-                                self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                                self.visit(*rel, r, id, binds, checks, &mut seen, rest, env, k)?;
                             }
                         }
                     }
@@ -576,7 +598,7 @@ impl<'a> Exec<'a> {
                             }
                             let t = r.tuple(id);
                             if index.cols.iter().zip(&keyv).all(|(&c, v)| &t[c] == v) {
-                                self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                                self.visit(*rel, r, id, binds, checks, &mut seen, rest, env, k)?;
                             }
                         }
                     }
@@ -684,6 +706,7 @@ impl<'a> Exec<'a> {
         id: u32,
         binds: &[(usize, u32)],
         checks: &[(usize, compile::CExpr)],
+        seen: &mut Option<Seen<'_>>,
         rest: &[CStep],
         env: &mut Vec<Value>,
         k: &mut Cont<'_>,
@@ -696,6 +719,11 @@ impl<'a> Exec<'a> {
             if eval::eval(e, env)? != t[*c] {
                 return Ok(());
             }
+        }
+        if let Some(seen) = seen
+            && !seen.first(t)
+        {
+            return Ok(());
         }
         self.trail.push((rel as u32, id));
         let res = self.run(rest, env, k);
