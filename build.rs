@@ -1,5 +1,5 @@
-//! Compiles the rule programs `rules/*.dl` (the built-in rule base, one program),
-//! `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
+//! Compiles the built-in rule base (all `rules/*.dl` as one program, entry
+//! `"rules"`) and each `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
 //! using the same parser and checker as the interpreter.
 
 use std::fmt::Write as _;
@@ -74,53 +74,41 @@ fn main() {
     let mut table = Vec::new();
     for dir in ["rules", "tests/logic", "benches/logic"] {
         println!("cargo:rerun-if-changed={dir}");
-        let abs = root.join(dir);
-        if let Ok(rd) = std::fs::read_dir(&abs) {
+        // Included fragments live in subdirectories; watch them too.
+        if let Ok(rd) = std::fs::read_dir(root.join(dir)) {
             for e in rd.flatten() {
                 println!("cargo:rerun-if-changed={}", e.path().display());
             }
         }
-        let files = dl_files(&abs);
-        // The built-in rule base is one program over all of rules/*.dl; the
-        // test and bench programs are one program per file.
-        let units: Vec<(String, Vec<PathBuf>)> = if dir == "rules" {
-            if files.is_empty() {
-                Vec::new()
-            } else {
-                vec![(dir.to_string(), files)]
-            }
-        } else {
-            files
-                .into_iter()
-                .map(|f| {
-                    (
-                        format!("{dir}/{}", f.file_name().unwrap().to_string_lossy()),
-                        vec![f],
-                    )
-                })
-                .collect()
-        };
-        if dir == "rules" {
-            // The rule text is embedded too: the interpreter (provenance, `why`)
-            // runs the same rules without the source tree.
-            let _ = writeln!(
-                out,
-                "/// The built-in rule base: (file name, text).\npub static BUILTIN_RULES: &[(&str, &str)] = &["
-            );
-            for (_, files) in &units {
-                for f in files {
-                    let name = format!("rules/{}", f.file_name().unwrap().to_string_lossy());
-                    let _ = writeln!(
-                        out,
-                        "    ({name:?}, include_str!({:?})),",
-                        f.display().to_string()
-                    );
-                }
-            }
-            out.push_str("];\n");
+    }
+    // The built-in rule base: all rules/*.dl form one program, also embedded
+    // as text so the interpreter can run it (explanations) without the sources.
+    let builtin = dl_files(&root.join("rules"));
+    out.push_str("/// The built-in rule base: (path, text) of every `rules/*.dl`.\n");
+    out.push_str("pub static BUILTIN_SOURCES: &[(&str, &str)] = &[\n");
+    for f in &builtin {
+        let name = format!("rules/{}", f.file_name().unwrap().to_string_lossy());
+        let _ = writeln!(
+            out,
+            "    ({name:?}, include_str!({:?})),",
+            f.display().to_string()
+        );
+    }
+    out.push_str("];\n");
+    if !builtin.is_empty() {
+        let program = front::load_files(&builtin, SIGS)
+            .unwrap_or_else(|e| panic!("the built-in rules do not check:\n{e}"));
+        match front::codegen::generate(&program, "builtin_rules") {
+            Ok(code) => out.push_str(&code),
+            Err(e) => panic!("the built-in rules cannot be compiled to ascent: {e}"),
         }
-        for (rel, files) in units {
-            let program = match front::load_files(&files, SIGS) {
+        table.push(("rules".to_string(), "builtin_rules".to_string()));
+    }
+    // Test and benchmark programs: one program per file.
+    for dir in ["tests/logic", "benches/logic"] {
+        for file in dl_files(&root.join(dir)) {
+            let rel = format!("{dir}/{}", file.file_name().unwrap().to_string_lossy());
+            let program = match front::load_files(std::slice::from_ref(&file), SIGS) {
                 Ok(p) => p,
                 Err(e) => panic!("rule program {rel} does not check:\n{e}"),
             };

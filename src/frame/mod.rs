@@ -52,7 +52,7 @@ impl Reasoned {
 
 /// The built-in rule base as a checked program (for the interpreter).
 pub fn builtin_program() -> Result<Program, Diagnostics> {
-    Program::parse_sources(compiled::BUILTIN_RULES)
+    Program::builtin()
 }
 
 /// Every `.dl` file of `dir`, sorted, as one program.

@@ -33,9 +33,10 @@ impl Program {
         front::load_files(&paths, &functors::signatures())
     }
 
-    /// Parse and check several named texts as one program.
-    pub fn parse_sources(sources: &[(&str, &str)]) -> Result<Program, Diagnostics> {
-        front::load_sources(sources, &functors::signatures())
+    /// The built-in rule base (`rules/*.dl`, embedded at build time) as one
+    /// checked program; its compiled form is `compiled::program("rules")`.
+    pub fn builtin() -> Result<Program, Diagnostics> {
+        front::load_sources(compiled::BUILTIN_SOURCES, &functors::signatures())
     }
 
     /// Parse and check program text; `name` is used in error messages.

@@ -196,6 +196,39 @@ impl Value {
             _ => None,
         }
     }
+    pub fn as_unsigned(&self) -> Option<u64> {
+        match self {
+            Value::Unsigned(n) => Some(*n),
+            _ => None,
+        }
+    }
+    pub fn as_vec3(&self) -> Option<Vector3<f64>> {
+        match self {
+            Value::Vec3(v) => Some(v.0),
+            _ => None,
+        }
+    }
+    pub fn as_iso(&self) -> Option<Isometry3<f64>> {
+        match self {
+            Value::Iso(i) => Some(i.0),
+            _ => None,
+        }
+    }
+    pub fn as_box(&self) -> Option<OBox> {
+        match self {
+            Value::Box(b) => Some(**b),
+            _ => None,
+        }
+    }
+    pub fn vec3(v: Vector3<f64>) -> Value {
+        Value::Vec3(Vec3(v))
+    }
+    pub fn iso(i: Isometry3<f64>) -> Value {
+        Value::Iso(Arc::new(Iso(i)))
+    }
+    pub fn obox(pose: Isometry3<f64>, half: Vector3<f64>) -> Value {
+        Value::Box(Arc::new(OBox { pose, half }))
+    }
     pub fn as_symbol(&self) -> Option<&str> {
         match self {
             Value::Symbol(s) => Some(s),
@@ -395,6 +428,16 @@ mod tests {
         let b = Value::parse(BaseTy::Box, "[1,2,3,1,0,0,0,0.5,0.5,1]").unwrap();
         assert_eq!(Value::parse(BaseTy::Box, &b.to_string()).unwrap(), b);
         assert!(Value::parse(BaseTy::Iso, "[1,2]").is_err());
+    }
+
+    #[test]
+    fn typed_accessors() {
+        let b = Value::obox(Isometry3::identity(), Vector3::new(1.0, 2.0, 3.0));
+        assert_eq!(b.as_box().unwrap().half, Vector3::new(1.0, 2.0, 3.0));
+        assert_eq!(Value::vec3(Vector3::x()).as_vec3(), Some(Vector3::x()));
+        assert!(Value::iso(Isometry3::identity()).as_iso().is_some());
+        assert_eq!(Value::Unsigned(3).as_unsigned(), Some(3));
+        assert_eq!(Value::Number(3).as_unsigned(), None);
     }
 
     #[test]

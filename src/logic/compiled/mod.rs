@@ -1,6 +1,7 @@
-//! Compiled engine: `build.rs` turns every `rules/*.dl` (the built-in rule
-//! base) and `tests/logic/*.dl` into an `ascent!` program with a wrapper
-//! `run(&edb) -> relations` on `Value` tuples. `PROGRAMS` lists them by path.
+//! Compiled engine: `build.rs` turns the built-in rule base (all `rules/*.dl`
+//! as one program, listed as `"rules"`) and every `tests/logic/*.dl` and
+//! `benches/logic/*.dl` (listed by path) into an `ascent!` program with a
+//! wrapper `run(&edb) -> relations` on `Value` tuples.
 
 pub mod rt;
 
@@ -14,7 +15,8 @@ pub type RunFn = fn(&Relations) -> Result<Relations, String>;
 
 include!(concat!(env!("OUT_DIR"), "/logic_compiled.rs"));
 
-/// The compiled program generated from `path` (relative to the crate root, e.g. `tests/logic/tc.dl`).
+/// The compiled program for `"rules"` (the built-in rule base; absent while
+/// `rules/` is empty) or a path such as `tests/logic/tc.dl`.
 pub fn program(path: &str) -> Option<RunFn> {
     PROGRAMS.iter().find(|(p, _)| *p == path).map(|(_, f)| *f)
 }

@@ -33,15 +33,19 @@ pub fn load_str(name: &str, text: &str, functors: &[FunctorSig]) -> Result<Progr
     loader.finish()
 }
 
-/// Parse and check several named texts as one program (e.g. rule files
-/// embedded in the binary); names appear in messages as file names.
+/// Parse and check several in-memory sources as one program (the embedded
+/// built-in rules); `.include` paths resolve against each source's directory.
 pub fn load_sources(
     sources: &[(&str, &str)],
     functors: &[FunctorSig],
 ) -> Result<Program, Diagnostics> {
     let mut loader = check::Loader::new(functors);
     for (name, text) in sources {
-        loader.load_text(name, text, Path::new("."))?;
+        let dir = Path::new(name)
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        loader.load_text(name, text, &dir)?;
     }
     loader.finish()
 }

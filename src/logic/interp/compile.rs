@@ -54,6 +54,10 @@ pub enum CStep {
         key: Vec<CExpr>,
         /// `key` when it is only variables (the fast path).
         key_slots: Option<Vec<u32>>,
+        /// Columns that later steps read, when some bound column is not read
+        /// (or is `_`): tuples agreeing on them give the same results, so only
+        /// the first is followed. Never set inside aggregates, where every match counts.
+        project: Option<Vec<usize>>,
         binds: Vec<(usize, u32)>,
         checks: Vec<(usize, CExpr)>,
         range: Range,
@@ -127,7 +131,10 @@ pub fn compile_rule(
         map: BTreeMap::new(),
     };
     let steps = compile_steps(prog, &rule.body, &rule.plan, &mut slots, rels, Vec::new());
-    let head = rule.head.args.iter().map(|e| expr(e, &mut slots)).collect();
+
+    let head: Vec<CExpr> = rule.head.args.iter().map(|e| expr(e, &mut slots)).collect();
+    let mut steps = steps;
+    set_projections(&mut steps, &head, rels);
     let head_rel = prog.rel_index[&rule.head.rel];
     let rec: Vec<usize> = steps
         .iter()
@@ -223,6 +230,7 @@ fn compile_steps(
                     rel,
                     index,
                     key_slots,
+                    project: None,
                     key,
                     binds,
                     checks,
@@ -363,5 +371,77 @@ fn expr(e: &Expr, slots: &mut Slots) -> CExpr {
             args.iter().map(|a| expr(a, slots)).collect(),
         ),
         ExprKind::Agg(_) => unreachable!("aggregates are lifted into their own literals"),
+    }
+}
+
+/// Mark scans whose bound columns are partly unused afterwards (see `CStep::Scan::project`).
+fn set_projections(steps: &mut [CStep], head: &[CExpr], rels: &[Relation]) {
+    for i in 0..steps.len() {
+        let mut used = Vec::new();
+        for s in &steps[i + 1..] {
+            step_reads(s, &mut used);
+        }
+        head.iter().for_each(|e| expr_reads(e, &mut used));
+        if let CStep::Scan {
+            rel,
+            key,
+            binds,
+            checks,
+            project,
+            ..
+        } = &mut steps[i]
+        {
+            let wild = rels[*rel].arity - key.len() - binds.len() - checks.len();
+            let live: Vec<usize> = binds
+                .iter()
+                .filter(|(_, s)| used.contains(s))
+                .map(|(c, _)| *c)
+                .collect();
+            if wild > 0 || live.len() < binds.len() {
+                *project = Some(live);
+            }
+        }
+    }
+}
+
+fn step_reads(s: &CStep, out: &mut Vec<u32>) {
+    match s {
+        CStep::Scan { key, checks, .. } => {
+            key.iter().for_each(|e| expr_reads(e, out));
+            checks.iter().for_each(|(_, e)| expr_reads(e, out));
+        }
+        CStep::Negate { key, .. } => key.iter().for_each(|e| expr_reads(e, out)),
+        CStep::Filter(_, _, a, b) | CStep::StrTest { a, b, .. } => {
+            expr_reads(a, out);
+            expr_reads(b, out);
+        }
+        CStep::Assign(_, e) => expr_reads(e, out),
+        CStep::AggAssign(_, g) => agg_reads(g, out),
+        CStep::AggFilter { other, agg, .. } => {
+            expr_reads(other, out);
+            agg_reads(agg, out);
+        }
+    }
+}
+
+fn agg_reads(g: &CAgg, out: &mut Vec<u32>) {
+    g.steps.iter().for_each(|s| step_reads(s, out));
+    if let Some(t) = &g.target {
+        expr_reads(t, out);
+    }
+}
+
+fn expr_reads(e: &CExpr, out: &mut Vec<u32>) {
+    match e {
+        CExpr::Slot(s) => out.push(*s),
+        CExpr::Const(_) => {}
+        CExpr::Neg(_, x) => expr_reads(x, out),
+        CExpr::Bin(_, _, a, b) => {
+            expr_reads(a, out);
+            expr_reads(b, out);
+        }
+        CExpr::Builtin(_, _, args) | CExpr::Ext(_, args) => {
+            args.iter().for_each(|a| expr_reads(a, out))
+        }
     }
 }

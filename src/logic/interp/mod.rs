@@ -239,6 +239,22 @@ impl Engine {
         let mut iteration = 0usize;
         loop {
             let mut produced: Vec<(usize, Relation, Vec<RecordedBody>)> = Vec::new();
+            if !self.program.strata[si].recursive {
+                // No rule of the stratum reads its relation: derive straight into it.
+                let head = members[0];
+                let mut target = std::mem::replace(&mut self.rels[head], Relation::new(0));
+                let mut target_prov = self.prov.as_mut().map(|p| std::mem::take(&mut p[head]));
+                let result = rules.iter().try_for_each(|rule| {
+                    self.eval_rule_into(rule, &lim, &mut target, target_prov.as_mut())
+                });
+                self.rels[head] = target;
+                if let (Some(p), Some(tp)) = (&mut self.prov, target_prov) {
+                    p[head] = tp;
+                }
+                result?;
+                stats.iterations += 1;
+                return self.check_tuple_limit(si, rules, None, 0);
+            }
             for rule in rules {
                 if iteration > 0 && !rule.recursive {
                     continue;
@@ -276,21 +292,7 @@ impl Engine {
                     }
                 }
             }
-            let total: usize = self.rels.iter().map(Relation::len).sum();
-            if total > self.options.limits.max_tuples {
-                let rule = best.map(|(r, _)| r).unwrap_or(rules[0].id);
-                return Err(LogicError::Limit {
-                    message: format!(
-                        "more than {} tuples (limit) after {} iteration(s) of the stratum of {}; rule {} `{}` keeps adding tuples",
-                        self.options.limits.max_tuples,
-                        iteration + 1,
-                        self.stratum_names(si),
-                        self.program.rule_name(rule),
-                        self.program.rules[rule]
-                    ),
-                    hint: "a rule that computes new values from its own output (e.g. `n(x+1) :- n(x).`) never stops; bound it with a condition such as `x < 100`, or raise the limit (--max-tuples)".into(),
-                });
-            }
+            self.check_tuple_limit(si, rules, best.map(|(r, _)| r), iteration)?;
             iteration += 1;
             stats.iterations += 1;
             if !grew || !self.program.strata[si].recursive {
@@ -312,6 +314,78 @@ impl Engine {
             for &m in &members {
                 lim[m] = (lim[m].1, self.rels[m].len() as u32);
             }
+        }
+        Ok(())
+    }
+
+    /// Stop with a clear error once the relations hold more tuples than allowed.
+    fn check_tuple_limit(
+        &self,
+        si: usize,
+        rules: &[CRule],
+        best: Option<usize>,
+        iteration: usize,
+    ) -> Result<(), LogicError> {
+        let total: usize = self.rels.iter().map(Relation::len).sum();
+        if total > self.options.limits.max_tuples {
+            let rule = best.unwrap_or(rules[0].id);
+            return Err(LogicError::Limit {
+                message: format!(
+                    "more than {} tuples (limit) after {} iteration(s) of the stratum of {}; rule {} `{}` keeps adding tuples",
+                    self.options.limits.max_tuples,
+                    iteration + 1,
+                    self.stratum_names(si),
+                    self.program.rule_name(rule),
+                    self.program.rules[rule]
+                ),
+                hint: "a rule that computes new values from its own output (e.g. `n(x+1) :- n(x).`) never stops; bound it with a condition such as `x < 100`, or raise the limit (--max-tuples)".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Evaluate a rule of a non-recursive stratum, inserting into its (taken out) head relation.
+    fn eval_rule_into(
+        &self,
+        rule: &CRule,
+        lim: &[(u32, u32)],
+        head: &mut Relation,
+        mut prov: Option<&mut Vec<Prov>>,
+    ) -> Result<(), LogicError> {
+        let mut env = vec![Value::Number(0); rule.slot_names.len()];
+        let mut ex = Exec {
+            rels: &self.rels,
+            lim,
+            trail: Vec::new(),
+        };
+        let mut tuple = Vec::with_capacity(head.arity);
+        let all_prov = self.prov.as_ref();
+        for steps in &rule.variants {
+            let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
+                tuple.clear();
+                for e in &rule.head {
+                    tuple.push(eval::eval(e, env)?);
+                }
+                let h = hash_values(tuple.iter());
+                if head.insert_hashed(&tuple, h).is_some()
+                    && let (Some(p), Some(all)) = (prov.as_deref_mut(), all_prov)
+                {
+                    let height = 1 + ex
+                        .trail
+                        .iter()
+                        .map(|&(r, id)| prov_height(&all[r as usize][id as usize]))
+                        .max()
+                        .unwrap_or(0);
+                    p.push(Prov::Derived {
+                        rule: rule.id as u32,
+                        body: ex.trail.clone().into_boxed_slice(),
+                        height,
+                    });
+                }
+                Ok(())
+            };
+            ex.run(steps, &mut env, &mut emit)
+                .map_err(|msg| self.runtime_error(rule, &env, msg))?;
         }
         Ok(())
     }
@@ -351,7 +425,10 @@ impl Engine {
                 for e in &rule.head {
                     tuple.push(eval::eval(e, env)?);
                 }
-                if head_rel.find(&tuple).is_none() && pending.insert(&tuple).is_some() && want_prov
+                let h = hash_values(tuple.iter());
+                if head_rel.find_hashed(&tuple, h).is_none()
+                    && pending.insert_hashed(&tuple, h).is_some()
+                    && want_prov
                 {
                     provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));
                 }
@@ -402,6 +479,26 @@ impl Engine {
     }
 }
 
+/// Projections of the tuples a scan has followed (see `CStep::Scan::project`).
+pub(crate) struct Seen<'c> {
+    cols: &'c [usize],
+    set: std::collections::HashSet<Vec<Value>, std::hash::BuildHasherDefault<store::FastHasher>>,
+}
+
+impl<'c> Seen<'c> {
+    fn new(cols: &'c [usize]) -> Self {
+        Seen {
+            cols,
+            set: Default::default(),
+        }
+    }
+    /// Whether no earlier tuple had the same projection.
+    fn first(&mut self, t: &[Value]) -> bool {
+        self.set
+            .insert(self.cols.iter().map(|&c| t[c].clone()).collect())
+    }
+}
+
 /// Rule index and the body tuples of one derivation.
 type RecordedBody = (u32, Box<[(u32, u32)]>);
 
@@ -443,11 +540,13 @@ impl<'a> Exec<'a> {
                 index,
                 key,
                 key_slots,
+                project,
                 binds,
                 checks,
                 range,
                 ..
             } => {
+                let mut seen = project.as_deref().map(Seen::new);
                 let r: &'a Relation = &self.rels[*rel];
                 let (old, end) = self.lim[*rel];
                 let (lo, hi) = match range {
@@ -461,7 +560,7 @@ impl<'a> Exec<'a> {
                 match index {
                     None => {
                         for id in lo..hi {
-                            self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                            self.visit(*rel, r, id, binds, checks, &mut seen, rest, env, k)?;
                         }
                     }
                     Some(ix) if key_slots.is_some() => {
@@ -481,7 +580,7 @@ impl<'a> Exec<'a> {
                                 .zip(slots)
                                 .all(|(&c, &s)| t[c] == env[s as usize])
                             {
-                                self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                                self.visit(*rel, r, id, binds, checks, &mut seen, rest, env, k)?;
                             }
                         }
                     }
@@ -499,7 +598,7 @@ impl<'a> Exec<'a> {
                             }
                             let t = r.tuple(id);
                             if index.cols.iter().zip(&keyv).all(|(&c, v)| &t[c] == v) {
-                                self.visit(*rel, r, id, binds, checks, rest, env, k)?;
+                                self.visit(*rel, r, id, binds, checks, &mut seen, rest, env, k)?;
                             }
                         }
                     }
@@ -607,6 +706,7 @@ impl<'a> Exec<'a> {
         id: u32,
         binds: &[(usize, u32)],
         checks: &[(usize, compile::CExpr)],
+        seen: &mut Option<Seen<'_>>,
         rest: &[CStep],
         env: &mut Vec<Value>,
         k: &mut Cont<'_>,
@@ -619,6 +719,11 @@ impl<'a> Exec<'a> {
             if eval::eval(e, env)? != t[*c] {
                 return Ok(());
             }
+        }
+        if let Some(seen) = seen
+            && !seen.first(t)
+        {
+            return Ok(());
         }
         self.trail.push((rel as u32, id));
         let res = self.run(rest, env, k);

@@ -142,10 +142,16 @@ impl Relation {
     }
     /// The id of `t` if present.
     pub fn find(&self, t: &[Value]) -> Option<u32> {
+        self.find_hashed(t, hash_values(t.iter()))
+    }
+    /// `find` with the tuple's hash already computed (`hash_values` of all columns).
+    pub fn find_hashed(&self, t: &[Value], h: u64) -> Option<u32> {
         if self.arity == 0 {
             return (self.len > 0).then_some(0);
         }
-        let h = hash_values(t.iter());
+        if self.len == 0 {
+            return None;
+        }
         self.full
             .get(h)
             .iter()
@@ -154,6 +160,10 @@ impl Relation {
     }
     /// Append `t` unless present; returns its id if it was new.
     pub fn insert(&mut self, t: &[Value]) -> Option<u32> {
+        self.insert_hashed(t, hash_values(t.iter()))
+    }
+    /// `insert` with the tuple's hash already computed.
+    pub fn insert_hashed(&mut self, t: &[Value], h: u64) -> Option<u32> {
         debug_assert_eq!(t.len(), self.arity);
         if self.arity == 0 {
             if self.len > 0 {
@@ -162,7 +172,6 @@ impl Relation {
             self.len = 1;
             return Some(0);
         }
-        let h = hash_values(t.iter());
         if self.full.get(h).iter().any(|&id| self.tuple(id) == t) {
             return None;
         }
