@@ -5,6 +5,7 @@ use crate::geom::{ContactOptions, OrientedBox, contacts};
 use crate::ifc::Model;
 use crate::logic::compiled::Relations;
 use crate::logic::{Engine, LogicError, OBox, Origin, Value, Vec3};
+use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -66,6 +67,45 @@ impl Facts {
                 (name.to_string(), v)
             })
             .collect()
+    }
+
+    /// Splits the facts by spatial container (storey, building): a piece's
+    /// tuples go to its container's part, contacts only when both pieces share
+    /// it, and facts about no piece (the cell) to every part. Walls never span
+    /// containers, so each part can be reasoned on its own.
+    pub fn by_container(&self) -> Vec<Relations> {
+        let mut part_names: FxHashMap<&str, usize> = FxHashMap::default();
+        let mut part_of_piece: FxHashMap<&str, usize> = FxHashMap::default();
+        for (t, _) in self.tuples.get("piece_container").into_iter().flatten() {
+            if let (Some(p), Some(c)) = (t[0].as_symbol(), t[1].as_symbol()) {
+                let next = part_names.len();
+                part_of_piece.insert(p, *part_names.entry(c).or_insert(next));
+            }
+        }
+        let n = part_names.len().max(1);
+        let part_of = |v: Option<&Value>| {
+            v.and_then(Value::as_symbol)
+                .and_then(|p| part_of_piece.get(p).copied())
+        };
+        let mut parts: Vec<Relations> = vec![Relations::new(); n];
+        for (name, tuples) in &self.tuples {
+            let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); n];
+            for (tuple, _) in tuples {
+                match part_of(tuple.first()) {
+                    Some(k) if *name == "contact" => {
+                        if part_of(tuple.get(1)) == Some(k) {
+                            buckets[k].push(tuple.clone());
+                        }
+                    }
+                    Some(k) => buckets[k].push(tuple.clone()),
+                    None => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
+                }
+            }
+            for (part, bucket) in parts.iter_mut().zip(buckets) {
+                part.insert(name.to_string(), bucket);
+            }
+        }
+        parts
     }
 
     /// Inserts every tuple into an interpreter (relations the program does not declare are skipped).

@@ -83,11 +83,8 @@ pub fn reason(
 ) -> Result<Reasoned, FrameError> {
     let program = match engine {
         RuleEngine::Compiled if !provenance => {
-            let run = compiled::program("rules")
-                .ok_or_else(|| FrameError::Compiled("no compiled rule base".into()))?;
-            let relations = run(&facts.relations()).map_err(FrameError::Compiled)?;
             return Ok(Reasoned {
-                relations,
+                relations: reason_compiled(facts)?,
                 engine: None,
             });
         }
@@ -113,6 +110,33 @@ pub fn reason(
         relations,
         engine: Some(interpreter),
     })
+}
+
+/// The compiled rule base, run on each container's facts in parallel and the
+/// results merged (same relations as one run over everything).
+fn reason_compiled(facts: &Facts) -> Result<Relations, FrameError> {
+    use rayon::prelude::*;
+    let run = compiled::program("rules")
+        .ok_or_else(|| FrameError::Compiled("no compiled rule base".into()))?;
+    let mut parts = facts.by_container();
+    // Largest first, so the parallel runs finish together.
+    parts.sort_by_key(|p| std::cmp::Reverse(p.get("piece").map_or(0, Vec::len)));
+    let results: Vec<Relations> = parts
+        .par_iter()
+        .map(run)
+        .collect::<Result<_, String>>()
+        .map_err(FrameError::Compiled)?;
+    let mut merged = Relations::new();
+    for part in results {
+        for (name, tuples) in part {
+            merged.entry(name).or_default().extend(tuples);
+        }
+    }
+    for tuples in merged.values_mut() {
+        tuples.sort();
+        tuples.dedup();
+    }
+    Ok(merged)
 }
 
 /// Facts of a model with default options, reasoned with the compiled rules.

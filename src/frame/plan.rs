@@ -6,7 +6,7 @@ use crate::geom::Point3;
 use crate::ifc::Model;
 use crate::logic::Value;
 use nalgebra::{Isometry3, Vector3};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
 #[derive(Debug, Clone)]
 pub struct Plan {
@@ -129,6 +129,43 @@ impl Plan {
         for (p, w) in &wall_of {
             members.entry(w.as_str()).or_default().push(p.clone());
         }
+        // Precedence, nailing and framing targets bucketed by wall in one pass.
+        let mut precedence_by: BTreeMap<&str, Vec<(String, String, String)>> = BTreeMap::new();
+        for t in r.get("precedence") {
+            let (before, after) = (sym(&t[0]), sym(&t[1]));
+            if let (Some(w), Some(w2)) = (wall_of.get(&before), wall_of.get(&after))
+                && w == w2
+            {
+                precedence_by
+                    .entry(w.as_str())
+                    .or_default()
+                    .push((before, after, sym(&t[2])));
+            }
+        }
+        let mut nails_by: BTreeMap<&str, Vec<NailingTarget>> = BTreeMap::new();
+        for t in r.get("nailing_target") {
+            if let Some(w) = wall_of.get(&sym(&t[0])) {
+                nails_by.entry(w.as_str()).or_default().push(NailingTarget {
+                    plate: sym(&t[0]),
+                    member: sym(&t[1]),
+                    kind: sym(&t[2]),
+                    u: float(&t[3]),
+                    v: float(&t[4]),
+                    w: float(&t[5]),
+                    world: Point3::from(vec3(&t[6])),
+                    direction: vec3(&t[7]),
+                });
+            }
+        }
+        let mut framing_by: BTreeMap<&str, Vec<(String, Isometry3<f64>)>> = BTreeMap::new();
+        for t in r.get("framing_target") {
+            if let Some(w) = wall_of.get(&sym(&t[0])) {
+                framing_by
+                    .entry(w.as_str())
+                    .or_default()
+                    .push((sym(&t[0]), iso(&t[1])));
+            }
+        }
         let mut walls = Vec::new();
         for (n, key) in keys.iter().enumerate() {
             let mut list = members.get(key.as_str()).cloned().unwrap_or_default();
@@ -140,41 +177,21 @@ impl Plan {
                     index.get(p.as_str()).copied(),
                 )
             });
-            let in_wall: BTreeSet<&str> = list.iter().map(String::as_str).collect();
-            let mut precedence: Vec<(String, String, String)> = r
-                .get("precedence")
-                .iter()
-                .map(|t| (sym(&t[0]), sym(&t[1]), sym(&t[2])))
-                .filter(|(a, b, _)| in_wall.contains(a.as_str()) && in_wall.contains(b.as_str()))
-                .collect();
+            let mut precedence = precedence_by.remove(key.as_str()).unwrap_or_default();
             precedence.sort();
-            let mut nailing_targets: Vec<NailingTarget> = r
-                .get("nailing_target")
-                .iter()
-                .filter(|t| in_wall.contains(sym(&t[0]).as_str()))
-                .map(|t| NailingTarget {
-                    plate: sym(&t[0]),
-                    member: sym(&t[1]),
-                    kind: sym(&t[2]),
-                    u: float(&t[3]),
-                    v: float(&t[4]),
-                    w: float(&t[5]),
-                    world: Point3::from(vec3(&t[6])),
-                    direction: vec3(&t[7]),
-                })
-                .collect();
+            let mut nailing_targets = nails_by.remove(key.as_str()).unwrap_or_default();
             nailing_targets.sort_by(|a, b| {
                 (a.u, a.v, a.w)
                     .partial_cmp(&(b.u, b.v, b.w))
                     .unwrap_or(std::cmp::Ordering::Equal)
             });
-            let mut framing_targets: Vec<(String, Isometry3<f64>)> = r
-                .get("framing_target")
+            let position: BTreeMap<&str, usize> = order
                 .iter()
-                .filter(|t| in_wall.contains(sym(&t[0]).as_str()))
-                .map(|t| (sym(&t[0]), iso(&t[1])))
+                .enumerate()
+                .map(|(i, p)| (p.as_str(), i))
                 .collect();
-            framing_targets.sort_by_key(|(p, _)| order.iter().position(|o| o == p));
+            let mut framing_targets = framing_by.remove(key.as_str()).unwrap_or_default();
+            framing_targets.sort_by_key(|(p, _)| position.get(p.as_str()).copied());
             let group = groups.get(key);
             let size = sizes.get(key).copied().unwrap_or([f64::NAN; 3]);
             walls.push(Wall {
