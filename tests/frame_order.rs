@@ -88,3 +88,10 @@ fn own_models_order_satisfies_the_truth() {
         check_order(case);
     }
 }
+
+#[test]
+fn generated_models_order_satisfies_their_truth() {
+    for case in &frame_truth::synthetic_cases(16).cases {
+        check_order(case);
+    }
+}
