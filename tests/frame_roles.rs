@@ -147,7 +147,7 @@ fn dump() {
 }
 
 /// Generated buildings the rules were never tuned on.
-const SYNTHETIC_MODELS: usize = 16;
+const SYNTHETIC_MODELS: usize = 40;
 
 #[test]
 fn generated_models_walls_and_roles_match_their_truth() {

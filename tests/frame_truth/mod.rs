@@ -138,8 +138,16 @@ impl Lcg {
     }
 }
 
-/// Up to two openings that fit in a wall of `length` and `height`.
-fn random_openings(rng: &mut Lcg, length: f64, height: f64) -> Vec<synth::wall::OpeningSpec> {
+/// Up to two openings that fit in a wall of `length` and `height` under
+/// `top_plates` plates of thickness `t`. Some headers sit tight under the top
+/// plate or 10 mm below it (no room for cripples).
+fn random_openings(
+    rng: &mut Lcg,
+    length: f64,
+    height: f64,
+    top_plates: f64,
+    t: f64,
+) -> Vec<synth::wall::OpeningSpec> {
     use synth::wall::{OpeningKind, OpeningSpec};
     let mut openings = Vec::new();
     let mut u = 0.3;
@@ -149,7 +157,13 @@ fn random_openings(rng: &mut Lcg, length: f64, height: f64) -> Vec<synth::wall::
             break;
         }
         let start = rng.range(u, (length - width - 0.35).max(u));
-        let top = height - rng.range(0.45, 0.6);
+        // A 2x10 header (spans up to 6 ft) is 9-1/4 in deep.
+        let stud_top = height - top_plates * t;
+        let top = match rng.pick(&[0, 0, 1, 2]) {
+            0 => height - rng.range(0.45, 0.6),
+            1 => stud_top - 0.23495,
+            _ => stud_top - 0.23495 - 0.01,
+        };
         let kind = if rng.next() < 0.4 {
             OpeningKind::Door
         } else {
@@ -202,17 +216,20 @@ pub fn synthetic_cases(count: usize) -> Synthetic {
         let lumber = rng.pick(&[Lumber::L2X4, Lumber::L2X6]);
         let height = rng.range(2.3, 3.0);
         let (length, depth) = (rng.range(3.0, 9.0), rng.range(2.5, 7.0));
-        let t = lumber.width;
-        let lengths = [length, depth - 2.0 * t, length, depth - 2.0 * t];
+        let depth_t = lumber.width;
+        let lengths = [length, depth - 2.0 * depth_t, length, depth - 2.0 * depth_t];
+        let double_top_plate = rng.next() < 0.7;
+        let top_plates = if double_top_plate { 2.0 } else { 1.0 };
+        let t = lumber.thickness;
         let spec = BuildingSpec {
             length,
             depth,
             height,
             lumber,
             studs: StudLayout::OnCentre(rng.pick(&[12.0, 16.0, 19.2, 24.0]) * inch),
-            double_top_plate: rng.next() < 0.7,
+            double_top_plate,
             header_style: rng.pick(&[HeaderStyle::BuiltUp, HeaderStyle::Solid]),
-            openings: lengths.map(|l| random_openings(&mut rng, l, height)),
+            openings: lengths.map(|l| random_openings(&mut rng, l, height, top_plates, t)),
         };
         let name = format!("synthetic_{n}");
         let Ok(building) = frame_building(&spec, "Building", nalgebra::Vector3::zeros(), "") else {
