@@ -126,26 +126,6 @@ fn own_models_same_relations_on_both_engines() {
     }
 }
 
-/// For iterating on rules without a rebuild: `RULES_DIR=dir DUMP=model.ifc RELS=a,b`.
-#[test]
-fn dump() {
-    let Ok(f) = std::env::var("DUMP") else { return };
-    let engine = std::env::var("RULES_DIR")
-        .map_or(RuleEngine::Compiled, |d| RuleEngine::Directory(d.into()));
-    let case = Case {
-        name: f.clone(),
-        ifc: f.into(),
-        truth: serde_json::Value::Null,
-    };
-    let r = reasoned(&case, &engine);
-    for rel in std::env::var("RELS").unwrap_or_default().split(',') {
-        for t in r.get(rel) {
-            let s: Vec<String> = t.iter().map(|v| format!("{v}")).collect();
-            println!("{rel}({})", s.join(", "));
-        }
-    }
-}
-
 /// Generated buildings the rules were never tuned on.
 const SYNTHETIC_MODELS: usize = 40;
 
