@@ -26,12 +26,21 @@ fn benches(c: &mut Criterion) {
     group.bench_function("tm3_62_members", |b| b.iter(|| black_box(plan(&tm3))));
     let scale = root.join("../shared/ifc-testcases/g_scale_3storey.ifc");
     if scale.is_file() {
-        group.bench_function("g_scale_4020_members", |b| b.iter(|| black_box(plan(&scale))));
+        group.bench_function("g_scale_4020_members", |b| {
+            b.iter(|| black_box(plan(&scale)))
+        });
     } else {
         eprintln!("skipped g_scale: {} is absent", scale.display());
     }
     let layout = building::grid(&models::tm3_spec(), 29, 29, 3.0, "bench grid").expect("grid");
-    let written = write_ifc(&layout, &WriteOptions { file_name: "grid.ifc".into(), ..WriteOptions::default() }).expect("write");
+    let written = write_ifc(
+        &layout,
+        &WriteOptions {
+            file_name: "grid.ifc".into(),
+            ..WriteOptions::default()
+        },
+    )
+    .expect("write");
     let dir = tempfile::tempdir().expect("temp dir");
     let big = dir.path().join("grid.ifc");
     std::fs::write(&big, &written.ifc).expect("write model");

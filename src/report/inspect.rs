@@ -6,28 +6,29 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
+/// Borrows its text from the model, so a large report costs no second copy.
 #[derive(Debug, Serialize)]
-pub struct InspectReport {
-    pub schema: String,
-    pub schema_identifier: String,
-    pub length_unit: LengthUnit,
-    pub originating_system: String,
+pub struct InspectReport<'m> {
+    pub schema: &'static str,
+    pub schema_identifier: &'m str,
+    pub length_unit: &'m LengthUnit,
+    pub originating_system: &'m str,
     pub entity_count: usize,
-    pub members: Vec<MemberRow>,
-    pub warnings: Vec<Warning>,
+    pub members: Vec<MemberRow<'m>>,
+    pub warnings: &'m [Warning],
 }
 
 #[derive(Debug, Serialize)]
-pub struct MemberRow {
-    pub id: String,
+pub struct MemberRow<'m> {
+    pub id: &'m str,
     pub entity: u64,
-    pub global_id: String,
+    pub global_id: &'m str,
     pub piece: Option<usize>,
-    pub name: Option<String>,
-    pub ifc_type: String,
-    pub predefined_type: Option<String>,
-    pub parent_global_id: Option<String>,
-    pub material: Option<String>,
+    pub name: Option<&'m str>,
+    pub ifc_type: &'m str,
+    pub predefined_type: Option<&'m str>,
+    pub parent_global_id: Option<&'m str>,
+    pub material: Option<&'m str>,
     pub axis_start: [f64; 3],
     pub axis_end: [f64; 3],
     pub width: f64,
@@ -36,26 +37,26 @@ pub struct MemberRow {
     pub volume: f64,
 }
 
-impl InspectReport {
-    pub fn new(model: &Model) -> Self {
+impl<'m> InspectReport<'m> {
+    pub fn new(model: &'m Model) -> Self {
         let members = model
             .pieces()
             .iter()
             .map(|p| {
                 let (start, end) = p.axis();
                 MemberRow {
-                    id: p.id.clone(),
+                    id: &p.id,
                     entity: p.entity,
-                    global_id: p.global_id.clone(),
+                    global_id: &p.global_id,
                     piece: p.piece,
-                    name: p.name.clone(),
-                    ifc_type: p.ifc_type.clone(),
-                    predefined_type: p.predefined_type.clone(),
+                    name: p.name.as_deref(),
+                    ifc_type: &p.ifc_type,
+                    predefined_type: p.predefined_type.as_deref(),
                     parent_global_id: p
                         .parent
                         .and_then(|id| model.groups.get(&id))
-                        .map(|g| g.global_id.clone()),
-                    material: p.material.clone(),
+                        .map(|g| g.global_id.as_str()),
+                    material: p.material.as_deref(),
                     axis_start: round_point(&start),
                     axis_end: round_point(&end),
                     width: round_m(p.obox.width()),
@@ -66,13 +67,13 @@ impl InspectReport {
             })
             .collect();
         InspectReport {
-            schema: model.schema.name().to_string(),
-            schema_identifier: model.schema_identifier.clone(),
-            length_unit: model.length_unit.clone(),
-            originating_system: model.header().originating_system.clone(),
+            schema: model.schema.name(),
+            schema_identifier: &model.schema_identifier,
+            length_unit: &model.length_unit,
+            originating_system: &model.header().originating_system,
             entity_count: model.entity_count(),
             members,
-            warnings: model.warnings.clone(),
+            warnings: &model.warnings,
         }
     }
 
@@ -108,7 +109,7 @@ impl InspectReport {
         let mut by_type: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
         let mut products = std::collections::BTreeSet::new();
         for m in &self.members {
-            let slot = by_type.entry(&m.ifc_type).or_default();
+            let slot = by_type.entry(m.ifc_type).or_default();
             slot.1 += 1;
             if products.insert(m.entity) {
                 slot.0 += 1;
