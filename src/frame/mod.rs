@@ -2,6 +2,7 @@
 //! model. The compiled (ascent) engine is the normal path; the interpreter
 //! runs the same rules for `--rules-dir`, user rules and provenance.
 
+pub mod cell_facts;
 pub mod facts;
 
 use crate::ifc::Model;
@@ -10,6 +11,7 @@ use crate::logic::{Diagnostics, Engine, LogicError, Options, Program, Value};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+pub use cell_facts::cell_facts;
 pub use facts::{Facts, model_facts};
 
 #[derive(Debug, thiserror::Error)]
