@@ -5,6 +5,7 @@ pub mod inspect;
 pub mod robot;
 pub mod rules;
 pub mod synth;
+pub mod world;
 
 use std::io::Write;
 use std::process::ExitCode;
