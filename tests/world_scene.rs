@@ -5,7 +5,7 @@ use framewright::cell::Cell;
 use framewright::frame::RuleEngine;
 use framewright::frame::facts::density_of;
 use framewright::ifc::Model;
-use framewright::world::{Scene, json};
+use framewright::world::{Scene, ScenePiece, json};
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -290,5 +290,45 @@ fn shared_test_cases_build_scenes() {
                 p.mass
             );
         }
+    }
+}
+
+/// Pieces longer than conveyor 1 are named in a warning.
+#[test]
+fn pieces_longer_than_the_belt_are_warned_about() {
+    let mut cell = Cell::load("study-abb").unwrap();
+    cell.conveyor1.length = 0.95;
+    let s = scene("tm1.ifc", &cell);
+    let long: Vec<&str> = s
+        .pieces
+        .iter()
+        .filter(|p| p.size[0] > 0.95)
+        .map(|p| p.id.as_str())
+        .collect();
+    assert_eq!(long.len(), 2, "tm1's two 39 in plates");
+    for id in long {
+        let w = format!("{id}: this piece is 991 mm long, longer than conveyor 1 (950 mm)");
+        assert!(s.warnings.contains(&w), "{:?}", s.warnings);
+    }
+    // Everything from slot 0 on overhangs the upstream end.
+    assert!(s.pieces.iter().all(|p| p.beyond_belt.is_some()));
+}
+
+/// A header set on edge in the wall lies flat once the wall is laid down (../shared, skipped
+/// when absent); studs and plates lie on edge.
+#[test]
+fn headers_lie_flat_at_their_targets() {
+    let path = root().join("../shared/ifc-testcases/d_wall_door.ifc");
+    if !path.is_file() {
+        eprintln!("skipped: {} is absent", path.display());
+        return;
+    }
+    let cell = Cell::load("study-abb").unwrap();
+    let s = Scene::from_model_file(&path, &cell).unwrap();
+    let flat: Vec<&ScenePiece> = s.pieces.iter().filter(|p| !p.on_edge).collect();
+    assert!(!flat.is_empty());
+    for p in &s.pieces {
+        let width_up = (p.target_robot.rotation * Vector3::y()).z.abs() > 0.9;
+        assert_eq!(p.on_edge, width_up, "{}", p.id);
     }
 }

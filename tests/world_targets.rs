@@ -172,3 +172,71 @@ fn engines_agree_on_targets() {
     assert_eq!(a, b);
     assert_eq!(wa, wb);
 }
+
+/// The cell facts carry the keys the rules read, with the cell's numbers.
+#[test]
+fn cell_facts_hold_the_documented_keys() {
+    let cell = Cell::load("study-abb").unwrap();
+    let rel = cell_facts(&cell).relations();
+    let values: BTreeMap<String, f64> = rel["cell_value"]
+        .iter()
+        .map(|t| (sym(&t[0]), t[1].as_float().unwrap()))
+        .collect();
+    let choices: BTreeMap<String, String> = rel["cell_choice"]
+        .iter()
+        .map(|t| (sym(&t[0]), sym(&t[1])))
+        .collect();
+    for (key, expected) in [
+        ("assembly_offset_x", 0.531),
+        ("assembly_centre_y", 0.0),
+        ("assembly_surface_z", 0.0),
+        ("conveyor1_x", -1.30),
+        ("conveyor1_y", 11.20),
+        ("conveyor1_z", 0.80),
+        ("conveyor1_length", 8.0),
+        ("conveyor1_width", 0.30),
+        ("conveyor1_speed", 0.05),
+        ("conveyor1_lumber_gap", 0.150),
+        ("conveyor2_speed", 2.0),
+        ("robot_base_x", 0.0),
+        ("robot_base_yaw", 0.0),
+        ("robot_payload", 40.0),
+    ] {
+        assert!(
+            (values[key] - expected).abs() < 1e-12,
+            "{key}: {}",
+            values[key]
+        );
+    }
+    assert!((values["conveyor1_yaw"] + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert_eq!(choices["assembly_orientation"], "parallel");
+    assert_eq!(choices["cell_name"], "study-abb");
+}
+
+/// A moved and turned robot base: targets stay in the robot frame (the assembly keys are
+/// robot-frame numbers), and the scene's cell-frame targets follow the base.
+#[test]
+fn targets_are_in_the_robot_frame_for_a_moved_base() {
+    let mut cell = Cell::load("study-abb").unwrap();
+    let (before, _) = targets("tm1.ifc", &cell, RuleEngine::Compiled);
+    cell.robot_base = Isometry3::new(Vector3::new(1.0, -2.0, 0.0), Vector3::z() * 0.7);
+    let (after, _) = targets("tm1.ifc", &cell, RuleEngine::Compiled);
+    for (id, pose) in &before {
+        assert!(
+            close(
+                &pose.translation.vector,
+                &after[id].translation.vector,
+                1e-9
+            ),
+            "{id}"
+        );
+    }
+    let target = serde_json::to_value(framewright::world::FramingTarget {
+        piece: "p".into(),
+        wall: "w".into(),
+        pose: after.values().next().copied().unwrap(),
+    })
+    .unwrap();
+    assert_eq!(target["pose"]["matrix"].as_array().unwrap().len(), 4);
+    assert_eq!(target["wall_id"], "w");
+}

@@ -20,12 +20,12 @@ fn tidy3(v: [f64; 3]) -> [f64; 3] {
 }
 
 #[derive(Serialize)]
-struct Pose {
+pub(crate) struct Pose {
     position: [f64; 3],
     matrix: [[f64; 4]; 4],
 }
 
-fn pose(p: &Isometry3<f64>) -> Pose {
+pub(crate) fn pose(p: &Isometry3<f64>) -> Pose {
     let t = p.translation.vector;
     Pose {
         position: tidy3([t.x, t.y, t.z]),
@@ -123,6 +123,7 @@ struct PieceJson<'a> {
     mass: f64,
     spawn: Pose,
     beyond_belt: Option<f64>,
+    on_edge: bool,
     framing_target: TargetJson,
 }
 
@@ -196,6 +197,7 @@ pub fn to_json(scene: &Scene) -> String {
                 mass: tidy(p.mass),
                 spawn: pose(&p.spawn),
                 beyond_belt: p.beyond_belt.map(tidy),
+                on_edge: p.on_edge,
                 framing_target: TargetJson {
                     robot: pose(&p.target_robot),
                     cell: pose(&p.target_cell),

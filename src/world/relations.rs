@@ -17,6 +17,19 @@ pub struct FramingTarget {
     pub pose: Isometry3<f64>,
 }
 
+/// As JSON for `plan`: `{"piece", "wall_id", "pose": {"position", "matrix"}}` (robot frame,
+/// numbers rounded like the world JSON).
+impl serde::Serialize for FramingTarget {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = s.serialize_struct("FramingTarget", 3)?;
+        st.serialize_field("piece", &self.piece)?;
+        st.serialize_field("wall_id", &self.wall)?;
+        st.serialize_field("pose", &super::json::pose(&self.pose))?;
+        st.end()
+    }
+}
+
 /// Where a piece appears on conveyor 1 (cell frame) and its place in the queue (0 = first).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spawn {

@@ -66,6 +66,9 @@ pub struct ScenePiece {
     pub target_robot: Isometry3<f64>,
     /// The same in the cell frame.
     pub target_cell: Isometry3<f64>,
+    /// Whether it lies on edge (width vertical) at its target; false for pieces that lie flat
+    /// there, such as headers set on edge in the wall (`framing_flat`).
+    pub on_edge: bool,
 }
 
 /// Everything a simulator needs to build the cell and its lumber.
@@ -141,6 +144,11 @@ impl Scene {
             .iter()
             .filter_map(|t| Some((t[0].as_symbol()?, (t[1].as_symbol()?, t[2].as_float()?))))
             .collect();
+        let flat: std::collections::BTreeSet<&str> = r
+            .get("framing_flat")
+            .iter()
+            .filter_map(|t| t.first()?.as_symbol())
+            .collect();
         let products: BTreeMap<&str, _> =
             model.pieces().iter().map(|p| (p.id.as_str(), p)).collect();
 
@@ -174,6 +182,7 @@ impl Scene {
                 beyond_belt: beyond.get(&s.piece).copied(),
                 target_robot: target,
                 target_cell: cell.robot_base * target,
+                on_edge: !flat.contains(s.piece.as_str()),
                 id: s.piece,
             });
         }
