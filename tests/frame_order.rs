@@ -88,3 +88,13 @@ fn own_models_order_satisfies_the_truth() {
         check_order(case);
     }
 }
+
+/// Generated buildings the rules were never tuned on.
+const SYNTHETIC_MODELS: usize = 40;
+
+#[test]
+fn generated_models_order_satisfies_their_truth() {
+    for case in &frame_truth::synthetic_cases(SYNTHETIC_MODELS).cases {
+        check_order(case);
+    }
+}

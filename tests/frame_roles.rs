@@ -111,18 +111,10 @@ fn check_engines_agree(case: &Case) {
     }
 }
 
-/// The 4020-piece model is left to the compiled-vs-truth tests: the
-/// interpreter is too slow on it for a test run.
-const INTERPRETER_PIECE_LIMIT: usize = 500;
-
 #[test]
 fn shared_models_same_relations_on_both_engines() {
     let Some(cases) = shared_cases() else { return };
     for case in &cases {
-        if members(&case.truth).len() > INTERPRETER_PIECE_LIMIT {
-            eprintln!("{}: engines compared on the smaller models only", case.name);
-            continue;
-        }
         check_engines_agree(case);
     }
 }
@@ -134,22 +126,139 @@ fn own_models_same_relations_on_both_engines() {
     }
 }
 
-/// For iterating on rules without a rebuild: `RULES_DIR=dir DUMP=model.ifc RELS=a,b`.
+/// Generated buildings the rules were never tuned on.
+const SYNTHETIC_MODELS: usize = 40;
+
 #[test]
-fn dump() {
-    let Ok(f) = std::env::var("DUMP") else { return };
-    let engine = std::env::var("RULES_DIR")
-        .map_or(RuleEngine::Compiled, |d| RuleEngine::Directory(d.into()));
-    let case = Case {
-        name: f.clone(),
-        ifc: f.into(),
-        truth: serde_json::Value::Null,
-    };
-    let r = reasoned(&case, &engine);
-    for rel in std::env::var("RELS").unwrap_or_default().split(',') {
-        for t in r.get(rel) {
-            let s: Vec<String> = t.iter().map(|v| format!("{v}")).collect();
-            println!("{rel}({})", s.join(", "));
-        }
+fn generated_models_walls_and_roles_match_their_truth() {
+    for case in &frame_truth::synthetic_cases(SYNTHETIC_MODELS).cases {
+        check_walls_and_roles(case);
     }
+}
+
+#[test]
+fn generated_models_same_relations_on_both_engines() {
+    for case in &frame_truth::synthetic_cases(SYNTHETIC_MODELS).cases {
+        check_engines_agree(case);
+    }
+}
+
+/// Pieces the truth models do not have: blocking between studs (flat and on
+/// edge) and a doubled stud. Blocking is end-nailed through the studs it
+/// sits between; a doubled stud is a stud, nailed to both plates.
+#[test]
+fn blocking_and_doubled_studs() {
+    use framewright::synth::layout::{Role, WallBox};
+    use framewright::synth::models::single_wall;
+    use framewright::synth::wall::{HeaderStyle, StudLayout, WallSpec};
+    use framewright::synth::{Lumber, Piece, WriteOptions, write_ifc};
+    let spec = WallSpec {
+        id: "W".into(),
+        name: "Wall".into(),
+        length: 3.6576,
+        height: 2.4669,
+        lumber: Lumber::L2X4,
+        studs: StudLayout::OnCentre(0.4064),
+        double_top_plate: true,
+        header_style: HeaderStyle::BuiltUp,
+        openings: vec![],
+    };
+    let mut layout = single_wall("blocking", "blocking and a doubled stud", &spec).unwrap();
+    let wall = &mut layout.buildings[0].walls[0];
+    let (t, depth) = (Lumber::L2X4.thickness, Lumber::L2X4.width);
+    let mut studs: Vec<WallBox> = wall
+        .pieces
+        .iter()
+        .filter(|p| p.role == Role::Stud)
+        .map(|p| p.wall_box)
+        .collect();
+    studs.sort_by(|a, b| a.u[0].total_cmp(&b.u[0]));
+    let extra = [
+        // Flat blocking in the second bay, on edge in the third (flush with the outer face).
+        (
+            studs[1].u[1],
+            studs[2].u[0],
+            [1.2, 1.2 + t],
+            [0.0, depth],
+            "blocking flat",
+        ),
+        (
+            studs[2].u[1],
+            studs[3].u[0],
+            [1.0, 1.0 + depth],
+            [0.0, t],
+            "blocking on edge",
+        ),
+    ];
+    for (u0, u1, v, w, detail) in extra {
+        let b = WallBox { u: [u0, u1], v, w };
+        wall.pieces
+            .push(Piece::from_box(&wall.frame, Role::Sill, detail, "2x4", b));
+    }
+    let s = studs[5];
+    let doubled = WallBox {
+        u: [s.u[1], s.u[1] + t],
+        v: s.v,
+        w: s.w,
+    };
+    wall.pieces.push(Piece::from_box(
+        &wall.frame,
+        Role::Stud,
+        "doubled",
+        "2x4",
+        doubled,
+    ));
+
+    let written = write_ifc(&layout, &WriteOptions::default()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let ifc = dir.path().join("blocking.ifc");
+    std::fs::write(&ifc, &written.ifc).unwrap();
+    let case = Case {
+        name: "blocking".into(),
+        ifc,
+        truth: serde_json::to_value(&written.truth).unwrap(),
+    };
+    let r = reasoned(&case, &RuleEngine::Compiled);
+    let roles = by_piece(&r, "role");
+    let rank: BTreeMap<&str, i64> = by_piece(&r, "assembly_rank")
+        .into_iter()
+        .map(|(p, k)| (p, k.as_number().unwrap()))
+        .collect();
+    let precedence: BTreeSet<(&str, &str, &str)> = r
+        .get("precedence")
+        .iter()
+        .map(|t| (sym(&t[0]), sym(&t[1]), sym(&t[2])))
+        .collect();
+    for &(a, b, _) in &precedence {
+        assert!(rank[a] < rank[b], "{a} must precede {b}");
+    }
+    let mut seen = 0;
+    for m in members(&case.truth) {
+        let gid = text(&m["global_id"]);
+        let detail = text(&m["role_detail"]);
+        let want = match detail {
+            "blocking flat" | "blocking on edge" => {
+                let nailed_through = precedence
+                    .iter()
+                    .filter(|(_, b, why)| *b == gid && *why == "end_nailed_through")
+                    .count();
+                assert_eq!(nailed_through, 2, "{detail}: end-nailed through both studs");
+                seen += 1;
+                "blocking"
+            }
+            "doubled" => {
+                let nails = r
+                    .get("nailing_target")
+                    .iter()
+                    .filter(|t| sym(&t[1]) == gid)
+                    .count();
+                assert_eq!(nails, 4, "a doubled stud is nailed to both plates");
+                seen += 1;
+                "stud"
+            }
+            _ => text(&m["role"]),
+        };
+        assert_eq!(sym(roles[gid]), want, "{gid} ({detail})");
+    }
+    assert_eq!(seen, 3);
 }
