@@ -13,3 +13,4 @@ pub mod logic;
 pub mod report;
 pub mod step;
 pub mod synth;
+pub mod world;

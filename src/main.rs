@@ -31,6 +31,8 @@ enum Command {
     Robot(cli::robot::RobotCommand),
     /// Write a synthetic wood-frame IFC model (the bundled examples, benchmark models).
     Synth(cli::synth::SynthArgs),
+    /// Write the simulation world of a model on a cell (JSON scene or Webots world).
+    World(cli::world::WorldArgs),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +43,7 @@ fn main() -> ExitCode {
         Command::Rules(cmd) => cli::rules::run(cmd),
         Command::Robot(cmd) => cli::robot::run(cmd),
         Command::Synth(args) => cli::synth::run(args),
+        Command::World(args) => cli::world::run(args),
     };
     match result {
         Ok(code) => code,

@@ -6,6 +6,7 @@ pub mod plan;
 pub mod robot;
 pub mod rules;
 pub mod synth;
+pub mod world;
 
 use std::io::Write;
 use std::process::ExitCode;

@@ -3,6 +3,7 @@
 
 use super::{CmdResult, print_stdout, write_stdout};
 use framewright::cell::Cell;
+use framewright::frame::cell_facts::cell_facts;
 use framewright::frame::plan::Plan;
 use framewright::frame::{RuleEngine, model_facts, reason};
 use framewright::geom::ContactOptions;
@@ -30,12 +31,13 @@ pub struct PlanArgs {
 
 pub fn run(args: PlanArgs) -> CmdResult {
     let model = Model::open(&args.model)?;
-    let _cell = Cell::load(&args.cell)?;
+    let cell = Cell::load(&args.cell)?;
     let contacts = ContactOptions {
         tolerance: args.contact_tolerance / 1000.0,
         ..ContactOptions::default()
     };
-    let facts = model_facts(&model, &contacts);
+    let mut facts = model_facts(&model, &contacts);
+    facts.extend(cell_facts(&cell));
     let engine = args
         .rules_dir
         .map_or(RuleEngine::Compiled, RuleEngine::Directory);

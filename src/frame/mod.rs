@@ -2,6 +2,7 @@
 //! model. The compiled (ascent) engine is the normal path; the interpreter
 //! runs the same rules for `--rules-dir`, user rules and provenance.
 
+pub mod cell_facts;
 pub mod facts;
 pub mod plan;
 
@@ -11,6 +12,7 @@ use crate::logic::{Diagnostics, Engine, LogicError, Options, Program, Value};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+pub use cell_facts::cell_facts;
 pub use facts::{Facts, model_facts};
 
 #[derive(Debug, thiserror::Error)]

@@ -70,6 +70,13 @@ functor_table! {
         let r = nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(m));
         Iso(nalgebra::Isometry3::from_parts(nalgebra::Translation3::from(o.0), r))
     }
+    /// The direction `v` or `-v`, whichever has its largest-magnitude coordinate positive (the
+    /// first of equal ones): a sign convention for box axes, whose signs mean nothing.
+    fn canonical_dir(v: Vec3) -> Vec3 {
+        let a = v.0.map(f64::abs);
+        let k = if a.x >= a.y && a.x >= a.z { 0 } else if a.y >= a.z { 1 } else { 2 };
+        Vec3(if v.0[k] < 0.0 { -v.0 } else { v.0 })
+    }
     fn abs(x: F64) -> F64 { F64(x.0.abs()) }
     fn sqrt(x: F64) -> F64 { F64(x.0.sqrt()) }
 }

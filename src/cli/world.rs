@@ -1,0 +1,80 @@
+//! `framewright world MODEL.ifc [--cell C] --format json|wbt -o PATH`: the simulation world of a
+//! model on a cell, as a JSON scene or a Webots R2023b world. The output is written to a
+//! temporary file beside PATH and renamed over it, so a failure never leaves half a file.
+
+use super::{CmdResult, Failure, print_stdout};
+use framewright::cell::Cell;
+use framewright::world::{Scene, json, wbt};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum WorldFormat {
+    /// The scene as JSON (framewright.world/1).
+    Json,
+    /// A Webots R2023b world.
+    Wbt,
+}
+
+#[derive(clap::Args)]
+pub struct WorldArgs {
+    /// The IFC model.
+    pub model: PathBuf,
+    /// Built-in cell name (study-abb, study-kuka) or a cell TOML file.
+    #[arg(long, default_value = "study-abb")]
+    pub cell: String,
+    #[arg(long, value_enum)]
+    pub format: WorldFormat,
+    /// Output file (`-` for stdout).
+    #[arg(short = 'o', long = "output", value_name = "PATH")]
+    pub output: PathBuf,
+}
+
+pub fn run(args: WorldArgs) -> CmdResult {
+    let cell = Cell::load(&args.cell)?;
+    let scene = Scene::from_model_file(&args.model, &cell)?;
+    let text = match args.format {
+        WorldFormat::Json => json::to_json(&scene),
+        WorldFormat::Wbt => wbt::to_wbt(&scene),
+    };
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    if args.output == Path::new("-") {
+        return print_stdout(&text);
+    }
+    write_atomically(&args.output, text.as_bytes()).map_err(|e| {
+        Failure::bad_input(format!(
+            "{}: cannot write the world: {e}",
+            args.output.display()
+        ))
+    })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Writes `bytes` to a temporary file in `path`'s directory, then renames it over `path`.
+fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::other("the output path names no file"))?;
+    let tmp = dir.join(format!(
+        ".{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
