@@ -39,7 +39,9 @@ pub enum RuleEngine {
     Directory(PathBuf),
 }
 
-/// The evaluated rule base: every relation by name (tuples sorted).
+/// The evaluated rule base: every relation by name. Tuples come in a
+/// deterministic order: sorted from the interpreter; from the compiled engine,
+/// storey by storey (each part sorted), small relations sorted whole.
 pub struct Reasoned {
     pub relations: Relations,
     /// The interpreter that ran, when one did (for explanations).
@@ -114,6 +116,9 @@ pub fn reason(
     })
 }
 
+/// Relations up to this size are sorted and deduplicated after merging parts.
+const SMALL_RELATION: usize = 4096;
+
 /// The compiled rule base, run on each container's facts in parallel and the
 /// results merged (same relations as one run over everything).
 fn reason_compiled(facts: &Facts) -> Result<Relations, FrameError> {
@@ -128,6 +133,11 @@ fn reason_compiled(facts: &Facts) -> Result<Relations, FrameError> {
         .map(run)
         .collect::<Result<_, String>>()
         .map_err(FrameError::Compiled)?;
+    // Parts are in a fixed order and each part's tuples come sorted, so the
+    // concatenation is deterministic. Relations keyed by a piece, wall or
+    // storey cannot share tuples between parts; only the small relations
+    // derived from the cell alone repeat in every part, so only small
+    // relations need sorting and deduplication.
     let mut merged = Relations::new();
     for part in results {
         for (name, tuples) in part {
@@ -135,8 +145,10 @@ fn reason_compiled(facts: &Facts) -> Result<Relations, FrameError> {
         }
     }
     for tuples in merged.values_mut() {
-        tuples.sort();
-        tuples.dedup();
+        if tuples.len() <= SMALL_RELATION {
+            tuples.sort();
+            tuples.dedup();
+        }
     }
     Ok(merged)
 }
