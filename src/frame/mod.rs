@@ -6,7 +6,6 @@ pub mod cell_facts;
 pub mod facts;
 pub mod plan;
 
-use crate::ifc::Model;
 use crate::logic::compiled::{self, Relations};
 use crate::logic::{Diagnostics, Engine, LogicError, Options, Program, Value};
 use std::path::{Path, PathBuf};
@@ -54,11 +53,6 @@ impl Reasoned {
     }
 }
 
-/// The built-in rule base as a checked program (for the interpreter).
-pub fn builtin_program() -> Result<Program, Diagnostics> {
-    Program::builtin()
-}
-
 /// Every `.dl` file of `dir`, sorted, as one program.
 pub fn directory_program(dir: &Path) -> Result<Program, FrameError> {
     let entries = std::fs::read_dir(dir).map_err(|e| FrameError::RulesDir {
@@ -92,7 +86,7 @@ pub fn reason(
                 engine: None,
             });
         }
-        RuleEngine::Compiled | RuleEngine::Interpreted => builtin_program()?,
+        RuleEngine::Compiled | RuleEngine::Interpreted => Program::builtin()?,
         RuleEngine::Directory(dir) => directory_program(dir)?,
     };
     let program = Arc::new(program);
@@ -151,10 +145,4 @@ fn reason_compiled(facts: &Facts) -> Result<Relations, FrameError> {
         }
     }
     Ok(merged)
-}
-
-/// Facts of a model with default options, reasoned with the compiled rules.
-pub fn reason_model(model: &Model) -> Result<Reasoned, FrameError> {
-    let facts = model_facts(model, &crate::geom::ContactOptions::default());
-    reason(&facts, &RuleEngine::Compiled, false)
 }
