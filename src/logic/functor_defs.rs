@@ -56,6 +56,12 @@ functor_table! {
     fn round_to(x: F64, step: F64) -> F64 {
         F64(if step.0 > 0.0 { (x.0 / step.0).round() * step.0 } else { x.0 })
     }
+    /// `x` written with `decimals` digits after the point (0..=9), for messages: `@fixed(1.23456, 3)` = "1.235".
+    fn fixed(x: F64, decimals: i64) -> Sym {
+        let d = decimals.clamp(0, 9) as usize;
+        let v = if x.0 == 0.0 { 0.0 } else { x.0 };
+        Sym::from(format!("{v:.d$}").as_str())
+    }
     /// Half the extent of a box along a direction (its projected radius).
     fn box_radius(b: OBox, d: Vec3) -> F64 {
         let n = d.0.norm();
