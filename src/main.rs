@@ -33,6 +33,8 @@ enum Command {
     Synth(cli::synth::SynthArgs),
     /// Write the simulation world of a model on a cell (JSON scene or Webots world).
     World(cli::world::WorldArgs),
+    /// Simulate the framing and nailing of every wall and print the verdicts.
+    Simulate(cli::simulate::SimulateArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +46,7 @@ fn main() -> ExitCode {
         Command::Robot(cmd) => cli::robot::run(cmd),
         Command::Synth(args) => cli::synth::run(args),
         Command::World(args) => cli::world::run(args),
+        Command::Simulate(args) => cli::simulate::run(args),
     };
     match result {
         Ok(code) => code,
