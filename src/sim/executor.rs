@@ -467,13 +467,11 @@ impl<'a> WallRun<'a> {
             if at.contains(&piece.id) && !self.phys.belts.running {
                 return Ok(());
             }
-            if let Some(other) = at
+            let other = at
                 .iter()
-                .find(|id| **id != piece.id && self.on_belts.contains(*id))
-            {
-                if !self.phys.belts.running {
-                    return Err(format!("{other} reached the sensor before it"));
-                }
+                .find(|id| **id != piece.id && self.on_belts.contains(*id));
+            if let (Some(other), false) = (other, self.phys.belts.running) {
+                return Err(format!("{other} reached the sensor before it"));
             }
             if self.t - start > limit {
                 let where_ = self
