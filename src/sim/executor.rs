@@ -264,6 +264,15 @@ impl<'a> WallRun<'a> {
         if self.path_clear(&direct, ignore) {
             return direct;
         }
+        // An arc about the robot's base that keeps the tool's orientation turning evenly
+        // (a held piece stays level) and rises over the middle.
+        for bump in [0.3, 0.7] {
+            if let Some(path) = self.arc(from, to, tcp, bump) {
+                if self.path_clear(&path, ignore) {
+                    return path;
+                }
+            }
+        }
         let up = |q: &[f64], h: f64| -> Option<Vec<f64>> {
             let pose = self.cell.robot_base * self.cell.robot.fk_tip(q) * tcp;
             let raised = Isometry3::from_parts(
@@ -289,6 +298,47 @@ impl<'a> WallRun<'a> {
             }
         }
         direct
+    }
+
+    /// Joint waypoints along a TCP arc about the base from the pose at `from` to the pose at
+    /// `to`: radius, angle and height interpolated, the height raised by `bump` mid-way.
+    fn arc(
+        &self,
+        from: &[f64],
+        to: &[f64],
+        tcp: &Isometry3<f64>,
+        bump: f64,
+    ) -> Option<Vec<Vec<f64>>> {
+        let base = self.cell.robot_base;
+        let a = base * self.cell.robot.fk_tip(from) * tcp;
+        let b = base * self.cell.robot.fk_tip(to) * tcp;
+        let local = |p: &Isometry3<f64>| base.inverse() * Point3::from(p.translation.vector);
+        let (pa, pb) = (local(&a), local(&b));
+        let (ra, rb) = (pa.xy().coords.norm(), pb.xy().coords.norm());
+        let ta = pa.y.atan2(pa.x);
+        let mut tb = pb.y.atan2(pb.x);
+        while tb - ta > std::f64::consts::PI {
+            tb -= 2.0 * std::f64::consts::PI;
+        }
+        while ta - tb > std::f64::consts::PI {
+            tb += 2.0 * std::f64::consts::PI;
+        }
+        const SAMPLES: usize = 12;
+        let mut path = vec![from.to_vec()];
+        let mut q = from.to_vec();
+        for k in 1..SAMPLES {
+            let s = k as f64 / SAMPLES as f64;
+            let (r, th) = (ra + (rb - ra) * s, ta + (tb - ta) * s);
+            let z = pa.z + (pb.z - pa.z) * s + bump * (std::f64::consts::PI * s).sin();
+            let yaw = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), (tb - ta) * s);
+            let rotation = base.rotation * yaw * (base.rotation.inverse() * a.rotation);
+            let point = base * Point3::new(r * th.cos(), r * th.sin(), z);
+            let pose = Isometry3::from_parts(Translation3::from(point.coords), rotation);
+            q = solve(self.cell, &pose, tcp, &q).ok()?;
+            path.push(q.clone());
+        }
+        path.push(to.to_vec());
+        Some(path)
     }
 
     fn path_clear(&self, path: &[Vec<f64>], ignore: &[&str]) -> bool {
