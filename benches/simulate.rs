@@ -10,7 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 fn bench(c: &mut Criterion) {
-    let model = Model::open(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc"))
+    let model = Model::open(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc"))
         .expect("bundled model");
     let cell = Cell::load("study-abb").expect("cell");
     let options = SimOptions::default();

@@ -29,6 +29,9 @@ const NAIL_APPROACH: f64 = 0.10;
 const GRIP_TIME: f64 = 0.5;
 const RELEASE_TIME: f64 = 0.3;
 const FIRE_TIME: f64 = 0.2;
+/// A piece more than this far from where the plan expected it when the jaws close is not
+/// held (m).
+const GRIP_TOLERANCE: f64 = 0.005;
 /// Straight-line TCP speed and acceleration.
 const LINE_SPEED: f64 = 0.25;
 const LINE_ACCEL: f64 = 1.0;
@@ -100,6 +103,8 @@ struct FramingPlan {
     q_above_place: Vec<f64>,
     pick_margin: f64,
     place_margin: f64,
+    /// The piece's body pose the pick was planned on.
+    pick_body: Isometry3<f64>,
     /// The target orientation actually used (a box has four equivalent ones).
     target: Isometry3<f64>,
 }
@@ -267,10 +272,10 @@ impl<'a> WallRun<'a> {
         // An arc about the robot's base that keeps the tool's orientation turning evenly
         // (a held piece stays level) and rises over the middle.
         for bump in [0.3, 0.7] {
-            if let Some(path) = self.arc(from, to, tcp, bump) {
-                if self.path_clear(&path, ignore) {
-                    return path;
-                }
+            if let Some(path) = self.arc(from, to, tcp, bump)
+                && self.path_clear(&path, ignore)
+            {
+                return path;
             }
         }
         let up = |q: &[f64], h: f64| -> Option<Vec<f64>> {
@@ -607,6 +612,36 @@ impl<'a> WallRun<'a> {
         self.wait(GRIP_TIME);
         let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
         let body = self.phys.lumber_pose(id).unwrap_or(piece.spawn);
+        // The jaws closed where the plan expected the piece; if it was not there (it moved
+        // after the plan, or the jaws pushed it), the grip failed.
+        let expected = plan.pick * grip.inverse();
+        let offset = (body.translation.vector
+            - (tool * expected.inverse() * plan.pick_body)
+                .translation
+                .vector)
+            .norm();
+        if ok && offset > GRIP_TOLERANCE {
+            self.phys.set_jaws(None);
+            let _ = self.run_line(
+                &LinearMove::new(
+                    plan.pick,
+                    raise(&plan.pick, CLEARANCE),
+                    LINE_SPEED,
+                    LINE_ACCEL,
+                ),
+                &grip,
+            );
+            self.end(id, "pick", start);
+            self.record.grip_failed.push((
+                id.to_string(),
+                format!(
+                    "the piece was {:.0} mm from where the jaws closed on it",
+                    offset * 1000.0
+                ),
+            ));
+            self.take_off(id);
+            return;
+        }
         self.phys.attach(id);
         self.held = Some(Held {
             id: id.to_string(),
@@ -778,6 +813,7 @@ impl<'a> WallRun<'a> {
                             best = Some((
                                 score,
                                 FramingPlan {
+                                    pick_body: body,
                                     pick_margin: reach_margin(self.cell, &pick, &grip),
                                     place_margin: reach_margin(self.cell, &place, &grip),
                                     pick,
