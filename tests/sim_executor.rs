@@ -9,7 +9,7 @@ use std::path::Path;
 
 fn model(name: &str) -> Model {
     Model::open(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
+        Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("examples/models")
             .join(name),
     )
