@@ -13,4 +13,5 @@ pub mod logic;
 pub mod report;
 pub mod step;
 pub mod synth;
+pub mod user_rules;
 pub mod world;

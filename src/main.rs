@@ -33,6 +33,12 @@ enum Command {
     Synth(cli::synth::SynthArgs),
     /// Write the simulation world of a model on a cell (JSON scene or Webots world).
     World(cli::world::WorldArgs),
+    /// Run user shop rules (violation/warning) over the model's relations.
+    Check(cli::check::CheckArgs),
+    /// Explain an element's verdicts down to IFC entities, cell keys and rules.
+    Why(cli::why::WhyArgs),
+    /// Say which rule could derive a tuple and which condition failed.
+    WhyNot(cli::why::WhyNotArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +50,9 @@ fn main() -> ExitCode {
         Command::Robot(cmd) => cli::robot::run(cmd),
         Command::Synth(args) => cli::synth::run(args),
         Command::World(args) => cli::world::run(args),
+        Command::Check(args) => cli::check::run(args),
+        Command::Why(args) => cli::why::run_why(args),
+        Command::WhyNot(args) => cli::why::run_why_not(args),
     };
     match result {
         Ok(code) => code,
