@@ -40,10 +40,10 @@ pub const FINDING_RELATIONS: [&str; 2] = ["violation", "warning"];
 #[derive(Debug, thiserror::Error)]
 pub enum UserRulesError {
     /// A rule file does not parse or check, or redefines a base relation.
-    #[error("{0}")]
+    #[error(transparent)]
     Rules(#[from] Diagnostics),
     /// A runtime error or a limit while evaluating the user rules.
-    #[error("{0}")]
+    #[error(transparent)]
     Logic(#[from] LogicError),
     #[error("{}: cannot read the rules directory: {message}", path.display())]
     RulesDir { path: PathBuf, message: String },

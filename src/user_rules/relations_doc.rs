@@ -8,7 +8,7 @@ use crate::logic::front::ast::RelDecl;
 use std::fmt::Write as _;
 
 /// The command that regenerates the committed file.
-pub const REGENERATE: &str = "framewright rules relations > docs/RELATIONS.md";
+pub const REGENERATE: &str = "cargo run -- rules relations > docs/RELATIONS.md";
 
 /// The Markdown reference of the relations of `base` (the built-in rule base)
 /// and of the findings relations user rules derive.
@@ -44,6 +44,7 @@ pub fn relations_markdown(base: &Program) -> String {
         for r in decls {
             write_relation(&mut s, r, &source.name, &source.text);
         }
+        s.push('\n');
     }
     let _ = writeln!(s, "## Outputs of user rules ({})\n", FINDINGS_SOURCE.0);
     if let Ok(findings) = Program::parse_str(FINDINGS_SOURCE.0, FINDINGS_SOURCE.1) {

@@ -11,6 +11,10 @@ use std::fmt::Write as _;
 
 /// Input facts of one relation shown under a node before the rest are folded.
 const FOLD_AFTER: usize = 3;
+/// Levels of a tree shown on a terminal; deeper facts are counted.
+const MAX_DEPTH: usize = 6;
+/// Conditions longer than this (aggregates over boxes) are cut.
+const MAX_CONDITION: usize = 160;
 
 pub fn render_why(reports: &[WhyReport]) -> String {
     let mut s = String::new();
@@ -34,17 +38,18 @@ pub fn render_why(reports: &[WhyReport]) -> String {
         if r.verdicts.is_empty() {
             s.push_str("  no verdicts: the rules derived nothing about this piece\n");
         }
-        let mut shown = BTreeSet::new();
         for v in &r.verdicts {
             s.push('\n');
-            render_verdict(&mut s, v, &mut shown);
+            render_verdict(&mut s, v);
         }
     }
     s
 }
 
-fn render_verdict(s: &mut String, v: &Verdict, shown: &mut BTreeSet<String>) {
-    render_node(s, &v.explanation, "", "", shown);
+fn render_verdict(s: &mut String, v: &Verdict) {
+    // Each verdict's tree stands on its own: a fact repeats across verdicts.
+    let mut shown = BTreeSet::new();
+    render_node(s, &v.explanation, "", "", 0, &mut shown);
     let src = &v.sources;
     let entities: Vec<String> = src.ifc_entities.iter().map(|n| format!("#{n}")).collect();
     let _ = writeln!(
@@ -114,6 +119,7 @@ fn render_node(
     e: &Explanation,
     first: &str,
     rest: &str,
+    depth: usize,
     shown: &mut BTreeSet<String>,
 ) {
     let head = fact(e);
@@ -134,6 +140,15 @@ fn render_node(
                 return;
             }
             let _ = writeln!(s, "{first}{head}  [by {rule}]");
+            if depth + 1 >= MAX_DEPTH && !premises.is_empty() {
+                let below = size(e) - 1;
+                let _ = writeln!(
+                    s,
+                    "{rest}└─ … {below} more fact{} below (--json has the whole tree)",
+                    if below == 1 { "" } else { "s" }
+                );
+                return;
+            }
             let lines = children(premises);
             for (i, line) in lines.iter().enumerate() {
                 let last = i + 1 == lines.len();
@@ -145,7 +160,7 @@ fn render_node(
                 let f = format!("{rest}{f}");
                 let r = format!("{rest}{r}");
                 match line {
-                    Child::Node(t) => render_node(s, t, &f, &r, shown),
+                    Child::Node(t) => render_node(s, t, &f, &r, depth + 1, shown),
                     Child::Text(t) => {
                         let _ = writeln!(s, "{f}{t}");
                     }
@@ -204,15 +219,23 @@ fn children(premises: &[Premise]) -> Vec<Child<'_>> {
         match p {
             Premise::Absent { atom } => out.push(Child::Text(format!(
                 "{}  [no such fact]",
-                shorten_numbers(atom)
+                cut(&shorten_numbers(atom))
             ))),
-            Premise::Condition { text } => {
-                out.push(Child::Text(format!("{}  [holds]", shorten_numbers(text))))
-            }
+            Premise::Condition { text } => out.push(Child::Text(format!(
+                "{}  [holds]",
+                cut(&shorten_numbers(text))
+            ))),
             Premise::Tuple(_) => {}
         }
     }
     out
+}
+
+fn cut(text: &str) -> String {
+    match text.char_indices().nth(MAX_CONDITION) {
+        Some((i, _)) => format!("{} …", &text[..i]),
+        None => text.to_string(),
+    }
 }
 
 pub fn render_why_not(query: &str, report: &WhyNotReport) -> String {
@@ -221,7 +244,7 @@ pub fn render_why_not(query: &str, report: &WhyNotReport) -> String {
         WhyNotReport::Holds { explanation } => {
             let _ = writeln!(s, "{query} holds:");
             let mut shown = BTreeSet::new();
-            render_node(&mut s, explanation, "", "", &mut shown);
+            render_node(&mut s, explanation, "", "", 0, &mut shown);
         }
         WhyNotReport::NotDerived { tree } => render_why_not_node(&mut s, tree, ""),
     }
@@ -229,13 +252,83 @@ pub fn render_why_not(query: &str, report: &WhyNotReport) -> String {
 }
 
 fn render_why_not_node(s: &mut String, node: &WhyNotNode, indent: &str) {
-    for line in node.why_not.render().lines() {
-        let _ = writeln!(s, "{indent}{}", shorten_numbers(line));
+    use crate::logic::provenance::Failure;
+    let w = &node.why_not;
+    let args: Vec<String> = w.tuple.iter().map(short_value).collect();
+    let _ = writeln!(
+        s,
+        "{indent}{}({}) is not derived.",
+        w.relation,
+        args.join(", ")
+    );
+    if let Some(r) = &w.reason {
+        let _ = writeln!(s, "{indent}  {r}");
+    }
+    let mut head_misfits = 0;
+    for a in &w.rules {
+        let text = match &a.failure {
+            Failure::Head { .. } => {
+                head_misfits += 1;
+                continue;
+            }
+            Failure::NoMatch {
+                atom,
+                candidates,
+                relation_size,
+            } => {
+                let mut t = format!(
+                    "no {} fact matches {}",
+                    relation_of(atom),
+                    shorten_numbers(atom)
+                );
+                if candidates.is_empty() {
+                    t.push_str(" (the relation is empty)");
+                } else {
+                    let _ = write!(t, "; closest of {relation_size}:");
+                    for c in candidates {
+                        let vals: Vec<String> = c.iter().map(short_value).collect();
+                        let _ = write!(t, "\n{indent}      ({})", vals.join(", "));
+                    }
+                }
+                t
+            }
+            Failure::NegationHolds { atom, existing } => {
+                let vals: Vec<String> = existing.iter().map(short_value).collect();
+                format!(
+                    "{} fails: the fact exists ({})",
+                    shorten_numbers(atom),
+                    vals.join(", ")
+                )
+            }
+            Failure::ConditionFalse { condition, example } => format!(
+                "condition `{condition}` is false, e.g. {}",
+                cut(&shorten_numbers(example))
+            ),
+            Failure::Derivable => {
+                "every condition holds: the tuple is derivable (the rules have not run?)".into()
+            }
+        };
+        let _ = writeln!(s, "{indent}- {}: {}", a.rule, a.rule_text);
+        let _ = writeln!(s, "{indent}    {text}");
+    }
+    if head_misfits > 0 {
+        let _ = writeln!(
+            s,
+            "{indent}- and {head_misfits} rule{} whose head cannot give this tuple",
+            if head_misfits == 1 { "" } else { "s" }
+        );
     }
     let deeper = format!("{indent}    ");
     for b in &node.because {
+        let _ = writeln!(s, "{indent}  because:");
         render_why_not_node(s, b, &deeper);
     }
+}
+
+/// `rel` of an atom written `rel(...)` or `!rel(...)`.
+fn relation_of(atom: &str) -> &str {
+    let a = atom.trim_start_matches('!');
+    a.split('(').next().unwrap_or(a)
 }
 
 /// A value as a person reads it: numbers to 0.1 mm / 6 digits.

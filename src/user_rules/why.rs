@@ -16,31 +16,33 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Relations whose tuples about an element (first argument = its id) are its
-/// verdicts, in the order they are shown: simulation outcomes, user
-/// findings, built-in warnings, then what the plan decided.
+/// verdicts, in the order they are shown: simulation outcomes (the reasons
+/// first: a failed status is derived most directly from "not placed"),
+/// user findings, built-in warnings, then what the plan decided.
 pub const VERDICT_RELATIONS: &[&str] = &[
+    "element_reason",
     "element_framing",
     "element_nailing",
-    "element_reason",
     "violation",
     "warning",
     "frame_warning",
     "world_warning",
-    "spawn_beyond_belt",
-    "framing_flat",
     "role",
     "wall_of",
     "assembly_rank",
     "framing_target",
+    "framing_flat",
+    "spawn_beyond_belt",
 ];
 
 #[derive(Debug, thiserror::Error)]
 pub enum WhyError {
-    #[error("{0}")]
+    #[error(transparent)]
     Rules(#[from] UserRulesError),
-    #[error("{0}")]
+    #[error(transparent)]
     Logic(#[from] LogicError),
-    /// The ID names no piece of the model (the message lists the closest ids).
+    /// The ID names no piece of the model (the message lists the closest
+    /// ids), or the query names no relation.
     #[error("{0}")]
     UnknownElement(String),
 }
@@ -369,6 +371,17 @@ const WHY_NOT_NODES: usize = 24;
 pub fn why_not(ctx: &Context<'_>, query: &str) -> Result<WhyNotReport, WhyError> {
     let program = full_program(ctx.base, ctx.user_files)?;
     let query = substitute_entities(ctx.model, query)?;
+    let name = query.split('(').next().unwrap_or("").trim();
+    if program.relation(name).is_none() {
+        let names = program.relations.iter().map(|r| r.name.as_str());
+        let hint = match crate::logic::front::diag::closest(name, names) {
+            Some(c) => format!("did you mean `{c}`? "),
+            None => String::new(),
+        };
+        return Err(WhyError::UnknownElement(format!(
+            "unknown relation `{name}` in `{query}`; {hint}`framewright rules relations` lists the built-in relations"
+        )));
+    }
     let (rel, tuple) = parse_query(&program, &query)?;
     let ids: BTreeSet<&str> = tuple.iter().filter_map(Value::as_symbol).collect();
     let containers = containers_of(ctx.facts, &ids);
