@@ -11,6 +11,7 @@ pub mod geom;
 pub mod ifc;
 pub mod logic;
 pub mod report;
+pub mod sim;
 pub mod step;
 pub mod synth;
 pub mod user_rules;

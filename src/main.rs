@@ -33,6 +33,8 @@ enum Command {
     Synth(cli::synth::SynthArgs),
     /// Write the simulation world of a model on a cell (JSON scene or Webots world).
     World(cli::world::WorldArgs),
+    /// Simulate the framing and nailing of every wall and print the verdicts.
+    Simulate(cli::simulate::SimulateArgs),
     /// Run user shop rules (violation/warning) over the model's relations.
     Check(cli::check::CheckArgs),
     /// Explain an element's verdicts down to IFC entities, cell keys and rules.
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
         Command::Robot(cmd) => cli::robot::run(cmd),
         Command::Synth(args) => cli::synth::run(args),
         Command::World(args) => cli::world::run(args),
+        Command::Simulate(args) => cli::simulate::run(args),
         Command::Check(args) => cli::check::run(args),
         Command::Why(args) => cli::why::run_why(args),
         Command::WhyNot(args) => cli::why::run_why_not(args),

@@ -6,6 +6,7 @@ pub mod inspect;
 pub mod plan;
 pub mod robot;
 pub mod rules;
+pub mod simulate;
 pub mod synth;
 pub mod why;
 pub mod world;

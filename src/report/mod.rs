@@ -3,6 +3,7 @@
 
 pub mod inspect;
 pub mod plan;
+pub mod simulate;
 
 /// Rounds a length to 1e-9 m (and turns -0 into 0).
 pub fn round_m(x: f64) -> f64 {

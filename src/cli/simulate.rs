@@ -1,0 +1,112 @@
+//! `framewright simulate MODEL.ifc [--cell C] [--json] [--wall W]…`: runs the framing and
+//! nailing of every wall in the physics simulation and prints the verdicts.
+
+use super::{CmdResult, print_stdout, write_stdout};
+use framewright::cell::Cell;
+use framewright::frame::RuleEngine;
+use framewright::ifc::Model;
+use framewright::report::simulate::SimReport;
+use framewright::sim::{SimOptions, simulate_with_progress};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+#[derive(clap::Args)]
+pub struct SimulateArgs {
+    /// The IFC model.
+    pub model: PathBuf,
+    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    #[arg(long, default_value = "study-abb")]
+    pub cell: String,
+    /// Print JSON instead of the tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Simulate only this wall (id or name); repeat for more.
+    #[arg(long = "wall", value_name = "W")]
+    pub walls: Vec<String>,
+    /// Replace the built-in rule base with every .dl file of this directory.
+    #[arg(long, value_name = "DIR")]
+    pub rules_dir: Option<PathBuf>,
+    /// Physics time step, milliseconds.
+    #[arg(long, value_name = "MS", default_value_t = 1000.0 / 120.0)]
+    pub step_ms: f64,
+    /// Fraction of the robot's joint speed and acceleration limits to move at (0..1].
+    #[arg(long, default_value_t = 1.0)]
+    pub speed: f64,
+}
+
+pub fn run(args: SimulateArgs) -> CmdResult {
+    let model = Model::open(&args.model)?;
+    let cell = Cell::load(&args.cell)?;
+    let options = SimOptions {
+        walls: args.walls,
+        dt: args.step_ms / 1000.0,
+        speed: args.speed,
+        engine: args
+            .rules_dir
+            .map_or(RuleEngine::Compiled, RuleEngine::Directory),
+    };
+    let name = args.model.file_name().map_or_else(
+        || args.model.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let bars = Bars::new();
+    let sim = simulate_with_progress(&model, &name, &cell, &options, &|wall, done, total| {
+        bars.update(wall, done, total)
+    })?;
+    bars.finish();
+    let report = SimReport::new(&sim, options.dt);
+    if args.json {
+        write_stdout(|out| report.write_json(out))
+    } else {
+        print_stdout(&report.to_text())
+    }
+}
+
+/// One progress bar per wall on a terminal (stderr); nothing otherwise.
+struct Bars {
+    multi: Option<MultiProgress>,
+    bars: Mutex<BTreeMap<String, ProgressBar>>,
+}
+
+impl Bars {
+    fn new() -> Bars {
+        let multi = std::io::stderr()
+            .is_terminal()
+            .then(|| MultiProgress::with_draw_target(ProgressDrawTarget::stderr()));
+        Bars {
+            multi,
+            bars: Mutex::new(BTreeMap::new()),
+        }
+    }
+
+    fn update(&self, wall: &str, done: usize, total: usize) {
+        let Some(multi) = &self.multi else {
+            return;
+        };
+        let Ok(mut bars) = self.bars.lock() else {
+            return;
+        };
+        let bar = bars.entry(wall.to_string()).or_insert_with(|| {
+            let bar = multi.add(ProgressBar::new(total as u64));
+            if let Ok(style) =
+                ProgressStyle::with_template("{prefix:>12} {bar:30} {pos}/{len} elements")
+            {
+                bar.set_style(style);
+            }
+            bar.set_prefix(wall.chars().take(12).collect::<String>());
+            bar
+        });
+        bar.set_position(done as u64);
+    }
+
+    fn finish(&self) {
+        if let Ok(bars) = self.bars.lock() {
+            for bar in bars.values() {
+                bar.finish_and_clear();
+            }
+        }
+    }
+}

@@ -1,0 +1,422 @@
+//! The report of `framewright simulate`: per wall the row of the study's results table
+//! (material feeding, framing, nailing), per element its verdicts and reasons, the nailing
+//! validation (planned targets against the as-built pieces), and the contacts. Everything
+//! comes from the verdict relations (`rules/verdicts.dl`) and the executor's records; no
+//! wall-clock figures, so the JSON is byte-identical run to run.
+
+use crate::frame::Reasoned;
+use crate::logic::Value;
+use crate::sim::Simulation;
+use crate::sim::record::NailOutcome;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Rounds to the micro-unit (µm, µs, µrad) and turns -0 into 0.
+fn r6(x: f64) -> f64 {
+    let r = (x * 1e6).round() / 1e6;
+    if r == 0.0 { 0.0 } else { r }
+}
+
+#[derive(Debug, Serialize)]
+pub struct SimReport {
+    pub schema: &'static str,
+    pub model: String,
+    pub cell: String,
+    pub walls: Vec<WallRow>,
+    pub elements: Vec<ElementRow>,
+    pub nailing_validation: NailingValidation,
+    pub contacts: Vec<ContactRow>,
+    pub sim: SimFigures,
+}
+
+#[derive(Debug, Serialize)]
+pub struct WallRow {
+    pub wall_id: String,
+    pub name: String,
+    pub material_feeding: String,
+    pub framing: Stage,
+    pub nailing: Stage,
+}
+
+#[derive(Debug, Serialize)]
+pub struct Stage {
+    pub status: String,
+    pub time_s: f64,
+    /// Components at fault, comma-separated ("" when none).
+    pub failed_component: String,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ElementRow {
+    pub id: String,
+    pub wall_id: String,
+    pub role: String,
+    pub framing: ElementStage,
+    pub nailing: ElementStage,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ElementStage {
+    pub status: String,
+    pub reasons: Vec<Reason>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Reason {
+    pub component: String,
+    pub message: String,
+}
+
+#[derive(Debug, Serialize)]
+pub struct NailingValidation {
+    /// Nails driven and checked against the as-built pieces.
+    pub checked: usize,
+    pub planned: usize,
+    /// Largest distance between a planned target and its as-built point, mm.
+    pub max_error_mm: f64,
+    /// Largest coordinate error relative to the planned coordinate, percent (coordinates
+    /// under 10 mm are left out: a relative error means nothing there).
+    pub max_error_pct: f64,
+    pub all_inside_members: bool,
+    pub targets: Vec<NailRow>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct NailRow {
+    pub wall_id: String,
+    pub plate: String,
+    pub member: String,
+    pub k: i64,
+    /// Planned wall coordinates u, v, w (m).
+    pub planned: [f64; 3],
+    /// The planned point carried by the as-built plate (m); absent when not driven.
+    pub as_built: Option<[f64; 3]>,
+    pub error_mm: Option<f64>,
+    pub error_pct: Option<f64>,
+    pub member_inside: Option<bool>,
+    pub status: String,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ContactRow {
+    pub wall_id: String,
+    pub element: String,
+    pub op: String,
+    pub t: f64,
+    pub body_a: String,
+    pub body_b: String,
+    pub depth_mm: f64,
+}
+
+#[derive(Debug, Serialize)]
+pub struct SimFigures {
+    /// Simulated seconds, summed over the walls.
+    pub simulated_s: f64,
+    pub steps: u64,
+    pub dt: f64,
+}
+
+fn sym(v: &Value) -> String {
+    v.as_symbol().unwrap_or_default().to_string()
+}
+
+fn float(v: &Value) -> f64 {
+    v.as_float().unwrap_or(f64::NAN)
+}
+
+/// Tuples of a relation as symbol/float rows.
+fn rows<'a>(r: &'a Reasoned, relation: &str) -> impl Iterator<Item = &'a [Value]> {
+    r.get(relation).iter().map(Vec::as_slice)
+}
+
+impl SimReport {
+    pub fn new(sim: &Simulation, dt: f64) -> SimReport {
+        let r = &sim.reasoned;
+        let mut reasons: BTreeMap<(String, String), Vec<Reason>> = BTreeMap::new();
+        for t in rows(r, "element_reason") {
+            reasons
+                .entry((sym(&t[0]), sym(&t[1])))
+                .or_default()
+                .push(Reason {
+                    component: sym(&t[2]),
+                    message: sym(&t[3]),
+                });
+        }
+        let status = |relation: &str| -> BTreeMap<String, String> {
+            rows(r, relation)
+                .map(|t| (sym(&t[0]), sym(&t[1])))
+                .collect()
+        };
+        let framing = status("element_framing");
+        let nailing = status("element_nailing");
+        let mut components: BTreeMap<(String, String), Vec<String>> = BTreeMap::new();
+        for t in rows(r, "wall_failed_component") {
+            components
+                .entry((sym(&t[0]), sym(&t[1])))
+                .or_default()
+                .push(sym(&t[2]));
+        }
+        let stages: BTreeMap<(String, String), (String, f64)> = rows(r, "wall_stage")
+            .map(|t| ((sym(&t[0]), sym(&t[1])), (sym(&t[2]), float(&t[3]))))
+            .collect();
+        let feeding = status("wall_feeding");
+
+        // Records and relations name a wall by its key piece; the report by the plan's id.
+        let walls_by_key: BTreeMap<&str, (&str, &str)> = sim
+            .plan
+            .walls
+            .iter()
+            .map(|w| (w.key.as_str(), (w.id.as_str(), w.name.as_str())))
+            .collect();
+        let wall_id = |key: &str| walls_by_key.get(key).map_or(key, |w| w.0).to_string();
+        let stage = |wall: &str, which: &str| {
+            let key = (wall.to_string(), which.to_string());
+            let (status, time) = stages.get(&key).cloned().unwrap_or_default();
+            let failed = components
+                .get(&key)
+                .map(|c| c.join(", "))
+                .unwrap_or_default();
+            Stage {
+                status,
+                time_s: r6(time),
+                failed_component: failed,
+            }
+        };
+        let walls = sim
+            .records
+            .iter()
+            .map(|rec| WallRow {
+                wall_id: wall_id(&rec.wall),
+                name: walls_by_key
+                    .get(rec.wall.as_str())
+                    .map_or("", |w| w.1)
+                    .to_string(),
+                material_feeding: feeding.get(&rec.wall).cloned().unwrap_or_default(),
+                framing: stage(&rec.wall, "framing"),
+                nailing: stage(&rec.wall, "nailing"),
+            })
+            .collect();
+
+        let mut elements = Vec::new();
+        for rec in &sim.records {
+            let wall = sim.scene.walls.iter().find(|w| w.id == rec.wall);
+            for id in wall.map(|w| w.pieces.as_slice()).unwrap_or_default() {
+                let stage = |which: &str, statuses: &BTreeMap<String, String>| ElementStage {
+                    status: statuses.get(id).cloned().unwrap_or_default(),
+                    reasons: reasons
+                        .get(&(id.clone(), which.to_string()))
+                        .cloned()
+                        .unwrap_or_default(),
+                };
+                elements.push(ElementRow {
+                    id: id.clone(),
+                    wall_id: wall_id(&rec.wall),
+                    role: sim.plan.roles.get(id).cloned().unwrap_or_default(),
+                    framing: stage("framing", &framing),
+                    nailing: stage("nailing", &nailing),
+                });
+            }
+        }
+
+        let mut targets = Vec::new();
+        let mut contacts = Vec::new();
+        for rec in &sim.records {
+            for n in &rec.nails {
+                let row = match &n.outcome {
+                    NailOutcome::Fired {
+                        as_built,
+                        position_error,
+                        member_inside,
+                        ..
+                    } => NailRow {
+                        wall_id: wall_id(&rec.wall),
+                        plate: n.plate.clone(),
+                        member: n.member.clone(),
+                        k: n.k,
+                        planned: n.planned.map(r6),
+                        as_built: Some(as_built.map(r6)),
+                        error_mm: Some(r6(position_error * 1000.0)),
+                        error_pct: Some(r6(relative_error(&n.planned, as_built))),
+                        member_inside: Some(*member_inside),
+                        status: "fired".into(),
+                    },
+                    NailOutcome::Skipped { kind, .. } => NailRow {
+                        wall_id: wall_id(&rec.wall),
+                        plate: n.plate.clone(),
+                        member: n.member.clone(),
+                        k: n.k,
+                        planned: n.planned.map(r6),
+                        as_built: None,
+                        error_mm: None,
+                        error_pct: None,
+                        member_inside: None,
+                        status: format!("skipped: {kind}"),
+                    },
+                };
+                targets.push(row);
+            }
+            for c in &rec.contacts {
+                contacts.push(ContactRow {
+                    wall_id: wall_id(&rec.wall),
+                    element: c.piece.clone(),
+                    op: c.op.to_string(),
+                    t: r6(c.t),
+                    body_a: c.body_a.clone(),
+                    body_b: c.body_b.clone(),
+                    depth_mm: r6(c.depth * 1000.0),
+                });
+            }
+        }
+        let fired: Vec<&NailRow> = targets.iter().filter(|t| t.error_mm.is_some()).collect();
+        let nailing_validation = NailingValidation {
+            checked: fired.len(),
+            planned: targets.len(),
+            max_error_mm: fired.iter().filter_map(|t| t.error_mm).fold(0.0, f64::max),
+            max_error_pct: fired.iter().filter_map(|t| t.error_pct).fold(0.0, f64::max),
+            all_inside_members: fired.iter().all(|t| t.member_inside == Some(true)),
+            targets,
+        };
+        SimReport {
+            schema: "framewright.simulate/1",
+            model: sim.scene.model.clone(),
+            cell: sim.scene.cell.clone(),
+            walls,
+            elements,
+            nailing_validation,
+            contacts,
+            sim: SimFigures {
+                simulated_s: r6(sim.records.iter().map(|r| r.nailing_end).sum()),
+                steps: sim.records.iter().map(|r| r.steps).sum(),
+                dt: r6(dt),
+            },
+        }
+    }
+
+    pub fn write_json(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        serde_json::to_writer_pretty(&mut *out, self)?;
+        writeln!(out)
+    }
+
+    /// The human report: the results table, failed elements with one-line reasons, the
+    /// nailing validation per target and the contacts.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "{:<24} {:<10} {:<10} {:>9} {:<16} {:<10} {:>9} {:<16}",
+            "wall", "feeding", "framing", "time", "failed", "nailing", "time", "failed"
+        );
+        for w in &self.walls {
+            let dash = |c: &str| {
+                if c.is_empty() {
+                    "-".to_string()
+                } else {
+                    c.to_string()
+                }
+            };
+            let _ = writeln!(
+                s,
+                "{:<24} {:<10} {:<10} {:>7.1} s {:<16} {:<10} {:>7.1} s {:<16}",
+                format!("{} ({})", w.name, short(&w.wall_id)),
+                w.material_feeding,
+                w.framing.status,
+                w.framing.time_s,
+                dash(&w.framing.failed_component),
+                w.nailing.status,
+                w.nailing.time_s,
+                dash(&w.nailing.failed_component),
+            );
+        }
+        let failed: Vec<&ElementRow> = self
+            .elements
+            .iter()
+            .filter(|e| e.framing.status != "framed" || !e.nailing.reasons.is_empty())
+            .collect();
+        if !failed.is_empty() {
+            let _ = writeln!(s, "\nfailed elements:");
+            for e in failed {
+                for (stage, st) in [("framing", &e.framing), ("nailing", &e.nailing)] {
+                    let Some(first) = st.reasons.first() else {
+                        continue;
+                    };
+                    let more = if st.reasons.len() > 1 {
+                        format!(" (+{} more)", st.reasons.len() - 1)
+                    } else {
+                        String::new()
+                    };
+                    let _ = writeln!(
+                        s,
+                        "  {} {:<13} {}: {} — {}{}",
+                        e.id, e.role, stage, first.component, first.message, more
+                    );
+                }
+            }
+        }
+        let v = &self.nailing_validation;
+        let _ = writeln!(
+            s,
+            "\nnailing validation: {} of {} nails driven and checked against the as-built pieces; max error {:.2} mm ({:.2} %); {}",
+            v.checked,
+            v.planned,
+            v.max_error_mm,
+            v.max_error_pct,
+            if v.all_inside_members {
+                "every nail runs into its member"
+            } else {
+                "SOME NAILS MISS THEIR MEMBER"
+            }
+        );
+        let _ = writeln!(
+            s,
+            "  {:<8} {:<24} {:<24} {:>2} {:>24} {:>24} {:>8}",
+            "wall", "plate", "member", "k", "planned u,v,w (m)", "as built u,v,w (m)", "err mm"
+        );
+        for t in &v.targets {
+            let uvw = |p: &[f64; 3]| format!("{:.4},{:.4},{:.4}", p[0], p[1], p[2]);
+            let _ = writeln!(
+                s,
+                "  {:<8} {:<24} {:<24} {:>2} {:>24} {:>24} {:>8}",
+                short(&t.wall_id),
+                t.plate,
+                t.member,
+                t.k,
+                uvw(&t.planned),
+                t.as_built.as_ref().map_or_else(|| t.status.clone(), uvw),
+                t.error_mm.map_or_else(|| "-".into(), |e| format!("{e:.2}")),
+            );
+        }
+        if !self.contacts.is_empty() {
+            let _ = writeln!(s, "\ncontacts the robot should not have made:");
+            for c in &self.contacts {
+                let _ = writeln!(
+                    s,
+                    "  t = {:>8.2} s  {} touched {} ({:.1} mm deep) during {} of {}",
+                    c.t, c.body_a, c.body_b, c.depth_mm, c.op, c.element
+                );
+            }
+        }
+        let _ = writeln!(
+            s,
+            "\nsimulated {:.1} s in {} steps of {:.2} ms",
+            self.sim.simulated_s,
+            self.sim.steps,
+            self.sim.dt * 1000.0
+        );
+        s
+    }
+}
+
+/// The largest coordinate error relative to the planned coordinate, percent, over the
+/// coordinates at least 10 mm from zero.
+fn relative_error(planned: &[f64; 3], built: &[f64; 3]) -> f64 {
+    (0..3)
+        .filter(|&i| planned[i].abs() >= 0.01)
+        .map(|i| 100.0 * (built[i] - planned[i]).abs() / planned[i].abs())
+        .fold(0.0, f64::max)
+}
+
+/// The first 8 characters of an id (GlobalIds are long).
+fn short(id: &str) -> &str {
+    id.get(..8).unwrap_or(id)
+}

@@ -1,0 +1,178 @@
+//! The executor: simulates the framing and nailing of every wall in rapier and feeds what
+//! happened back into the rules (`rules/sim.dl` facts → `rules/verdicts.dl` verdicts).
+//!
+//! Each wall runs in its own world (the study frames walls one at a time), so walls run in
+//! parallel and a wall's result depends only on its own pieces and the cell: same inputs,
+//! same bytes out.
+
+mod executor;
+mod motion;
+mod physics;
+mod reach;
+pub mod record;
+
+pub use executor::NailPlan;
+pub use motion::{JointMove, LinearMove, Profile};
+pub use record::WallRecord;
+
+use crate::cell::Cell;
+use crate::frame::plan::Plan;
+use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, cell_facts, model_facts, reason};
+use crate::geom::ContactOptions;
+use crate::ifc::Model;
+use crate::world::{Scene, WorldError};
+
+/// How to simulate.
+#[derive(Debug, Clone)]
+pub struct SimOptions {
+    /// Walls to run, by id or name; empty = every wall.
+    pub walls: Vec<String>,
+    /// Physics time step, s.
+    pub dt: f64,
+    /// Fraction of the robot's joint speed and acceleration limits its joint moves use.
+    pub speed: f64,
+    /// The rule base for reasoning and verdicts.
+    pub engine: RuleEngine,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        SimOptions {
+            walls: Vec::new(),
+            dt: 1.0 / 120.0,
+            speed: 1.0,
+            engine: RuleEngine::Compiled,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    #[error("{0}")]
+    World(#[from] WorldError),
+    #[error("{0}")]
+    Frame(#[from] FrameError),
+    #[error("no wall `{name}` in the model; its walls are: {known}")]
+    UnknownWall { name: String, known: String },
+    #[error("the model has no walls to simulate{reason}")]
+    NoWalls { reason: String },
+    #[error("bad simulation option: {0}")]
+    Option(String),
+}
+
+/// A finished simulation.
+pub struct Simulation {
+    pub scene: Scene,
+    pub plan: Plan,
+    /// One record per simulated wall, in wall order.
+    pub records: Vec<WallRecord>,
+    /// The `rules/sim.dl` facts of every record.
+    pub facts: Facts,
+    /// Model, cell and simulation facts reasoned with the rule base (verdicts included).
+    pub reasoned: Reasoned,
+}
+
+/// Simulates the walls of a model in a cell.
+pub fn simulate(model: &Model, cell: &Cell, options: &SimOptions) -> Result<Simulation, SimError> {
+    simulate_with_progress(model, "model", cell, options, &|_, _, _| {})
+}
+
+/// `simulate`, reporting (wall id, elements done, elements) as walls progress.
+pub fn simulate_with_progress(
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<Simulation, SimError> {
+    use rayon::prelude::*;
+    if !(options.dt > 0.0 && options.dt <= 0.05) {
+        return Err(SimError::Option(format!(
+            "the time step must be in (0, 0.05] s, not {}",
+            options.dt
+        )));
+    }
+    if !(options.speed > 0.0 && options.speed <= 1.0) {
+        return Err(SimError::Option(format!(
+            "the speed fraction must be in (0, 1], not {}",
+            options.speed
+        )));
+    }
+    let mut facts = model_facts(model, &ContactOptions::default());
+    facts.extend(cell_facts(cell));
+    let planned = reason(&facts, &options.engine, false)?;
+    let scene = Scene::build(model_name, model, cell, &planned)?;
+    let plan = Plan::from_reasoned(model, &planned);
+    let selected = select_walls(&plan, &options.walls)?;
+
+    let records: Vec<WallRecord> = selected
+        .par_iter()
+        .filter_map(|key| {
+            // The rules name a wall by its key piece; the scene does too.
+            let scene_wall = scene.walls.iter().find(|w| &w.id == key)?;
+            let plan_wall = plan.walls.iter().find(|w| &w.key == key)?;
+            let pieces = scene_wall
+                .pieces
+                .iter()
+                .filter_map(|id| scene.pieces.iter().find(|p| &p.id == id))
+                .collect();
+            let nails = NailPlan::from_targets(&plan_wall.nailing_targets, &plan_wall.frame);
+            let report = |done: usize, total: usize| progress(&plan_wall.name, done, total);
+            Some(executor::WallRun::new(cell, options, scene_wall, pieces, &report).run(&nails))
+        })
+        .collect();
+
+    let mut sim_facts = Facts::default();
+    for r in &records {
+        sim_facts.extend(r.facts());
+    }
+    facts.extend(sim_facts.clone());
+    let reasoned = reason(&facts, &options.engine, false)?;
+    Ok(Simulation {
+        scene,
+        plan,
+        records,
+        facts: sim_facts,
+        reasoned,
+    })
+}
+
+/// The keys (rule-base wall ids) of the walls to run: all, or those named (by id, name or
+/// key), in plan order.
+fn select_walls(plan: &Plan, wanted: &[String]) -> Result<Vec<String>, SimError> {
+    let with_pieces: Vec<&crate::frame::plan::Wall> = plan.walls.iter().collect();
+    if with_pieces.is_empty() {
+        let reason = if plan.warnings.is_empty() {
+            String::new()
+        } else {
+            format!(": {}", plan.warnings.join("; "))
+        };
+        return Err(SimError::NoWalls { reason });
+    }
+    if wanted.is_empty() {
+        return Ok(with_pieces.iter().map(|w| w.key.clone()).collect());
+    }
+    let mut ids = Vec::new();
+    for name in wanted {
+        let wall = with_pieces
+            .iter()
+            .find(|w| &w.id == name || &w.name == name || &w.key == name)
+            .ok_or_else(|| SimError::UnknownWall {
+                name: name.clone(),
+                known: with_pieces
+                    .iter()
+                    .map(|w| format!("{} ({})", w.name, w.id))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        if !ids.contains(&wall.key) {
+            ids.push(wall.key.clone());
+        }
+    }
+    Ok(plan
+        .walls
+        .iter()
+        .filter(|w| ids.contains(&w.key))
+        .map(|w| w.key.clone())
+        .collect())
+}

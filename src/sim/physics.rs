@@ -1,0 +1,549 @@
+//! The rapier world of one wall's run: floor, conveyors (belts that carry lumber by friction),
+//! the touch sensor and its end stop, the tool table, the robot's links and tool as
+//! position-driven bodies, and the lumber as dynamic bodies with their sizes and densities.
+//!
+//! rapier works in f32 with glam types; the rest of framewright in f64 with nalgebra. The
+//! conversions live here.
+
+use crate::cell::{Cell, PlacedShape, Shape};
+use crate::world::ScenePiece;
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use rapier3d::prelude::*;
+use std::collections::{BTreeMap, HashMap};
+
+/// rapier pose of an f64 isometry.
+pub fn to_pose(iso: &Isometry3<f64>) -> Pose {
+    iso.cast::<f32>().into()
+}
+
+/// f64 isometry of a rapier pose.
+pub fn to_iso(pose: &Pose) -> Isometry3<f64> {
+    let iso: Isometry3<f32> = (*pose).into();
+    iso.cast::<f64>()
+}
+
+// Collision groups: what may touch what.
+const FIXED: Group = Group::GROUP_1;
+const LUMBER: Group = Group::GROUP_2;
+const ROBOT: Group = Group::GROUP_3;
+const SENSOR: Group = Group::GROUP_4;
+
+fn groups(member: Group, filter: Group) -> InteractionGroups {
+    InteractionGroups::new(member, filter, InteractionTestMode::And)
+}
+
+/// Lumber friction against the belts, the floor and other lumber.
+const LUMBER_FRICTION: f32 = 0.6;
+const BELT_FRICTION: f32 = 0.8;
+/// Thickness of a belt slab under its top surface.
+const BELT_SLAB: f64 = 0.10;
+/// Conveyor 2's belt lies this much below its nominal height: lumber sliding across a seam
+/// between two flush slabs catches on the second slab's end face; a small step down does not.
+const TRANSFER_STEP: f64 = 0.002;
+/// How far in front of the end stop the sensor zone reaches.
+const SENSOR_REACH: f64 = 0.005;
+/// Finger plate thickness of a parallel gripper's jaws.
+pub const FINGER: f64 = 0.010;
+
+/// The belts: fixed colliders whose contacts get a tangential velocity (rapier's way of
+/// modelling a moving belt surface).
+pub struct Belts {
+    belts: Vec<(ColliderHandle, Vector, f32)>,
+    /// Both belts stop while the sensor holds a piece.
+    pub running: bool,
+}
+
+impl PhysicsHooks for Belts {
+    fn modify_solver_contacts(&self, ctx: &mut ContactModificationContext) {
+        if !self.running {
+            return;
+        }
+        for (belt, direction, speed) in &self.belts {
+            // tangent_velocity is the surface velocity of collider 1 relative to collider 2.
+            let sign = if ctx.collider1 == *belt {
+                1.0
+            } else if ctx.collider2 == *belt {
+                -1.0
+            } else {
+                continue;
+            };
+            let v = *direction * (*speed * sign);
+            if let Some(contacts) = ctx.rigid_mut() {
+                for c in contacts.solver_contacts.iter_mut() {
+                    c.tangent_velocity = v;
+                }
+            }
+            return;
+        }
+    }
+}
+
+/// A lumber piece in the world.
+#[derive(Debug, Clone, Copy)]
+pub struct LumberBody {
+    pub body: RigidBodyHandle,
+    pub collider: ColliderHandle,
+}
+
+/// The jaws of one gripper: two finger plates on either side of the TCP x axis.
+#[derive(Debug, Clone, Copy)]
+struct Finger {
+    collider: ColliderHandle,
+    /// The jaw part's centre in tool0 and the finger's side (+1 or -1 along the jaw axis).
+    centre: Isometry3<f64>,
+    side: f64,
+}
+
+/// The world and the handles the executor needs.
+pub struct Physics {
+    pub world: PhysicsWorld,
+    pub belts: Belts,
+    /// Robot link index → body (links with collision shapes), in link order.
+    pub links: Vec<(usize, RigidBodyHandle)>,
+    pub tool: RigidBodyHandle,
+    fingers: Vec<Finger>,
+    /// Every collider of the robot and its tool.
+    pub robot_colliders: Vec<ColliderHandle>,
+    pub sensor: ColliderHandle,
+    pub lumber: BTreeMap<String, LumberBody>,
+    /// Body names for contact reports.
+    names: HashMap<ColliderHandle, String>,
+    /// Lumber id by collider.
+    lumber_of: HashMap<ColliderHandle, String>,
+    cell: Cell,
+}
+
+impl Physics {
+    /// The cell without lumber; the robot at `q`.
+    pub fn new(cell: &Cell, q: &[f64], dt: f64) -> Physics {
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::new(0.0, 0.0, -9.81);
+        world.integration_parameters.dt = dt as f32;
+        let mut names = HashMap::new();
+        let fixed_groups = groups(FIXED, LUMBER | ROBOT);
+
+        let add_fixed = |world: &mut PhysicsWorld,
+                         names: &mut HashMap<ColliderHandle, String>,
+                         name: &str,
+                         pose: Isometry3<f64>,
+                         builder: ColliderBuilder| {
+            let (_, c) = world.insert(
+                RigidBodyBuilder::fixed().pose(to_pose(&pose)),
+                builder.collision_groups(fixed_groups),
+            );
+            names.insert(c, name.to_string());
+            c
+        };
+
+        // The floor: a slab whose top is the floor plane.
+        let f = cell.floor;
+        add_fixed(
+            &mut world,
+            &mut names,
+            "floor",
+            Isometry3::translation(0.0, 0.0, f.z - 0.05),
+            ColliderBuilder::cuboid(f.size[0] as f32 / 2.0, f.size[1] as f32 / 2.0, 0.05),
+        );
+
+        // Conveyors: a belt slab (with the belt hook) on a frame down to the floor.
+        let mut belts = Vec::new();
+        for (name, c, drop) in [
+            ("conveyor 1", &cell.conveyor1, 0.0),
+            ("conveyor 2", &cell.conveyor2, TRANSFER_STEP),
+        ] {
+            let slab = c.pose * Isometry3::translation(0.0, 0.0, -BELT_SLAB / 2.0 - drop);
+            let belt = add_fixed(
+                &mut world,
+                &mut names,
+                name,
+                slab,
+                ColliderBuilder::cuboid(
+                    c.length as f32 / 2.0,
+                    c.width as f32 / 2.0,
+                    BELT_SLAB as f32 / 2.0,
+                )
+                .friction(BELT_FRICTION)
+                .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS),
+            );
+            let direction = c.direction().cast::<f32>();
+            belts.push((
+                belt,
+                Vector::new(direction.x, direction.y, direction.z),
+                c.speed as f32,
+            ));
+            let frame_height = c.pose.translation.z - BELT_SLAB - f.z;
+            if frame_height > 0.01 {
+                let frame =
+                    c.pose * Isometry3::translation(0.0, 0.0, -BELT_SLAB - frame_height / 2.0);
+                add_fixed(
+                    &mut world,
+                    &mut names,
+                    &format!("{name} frame"),
+                    frame,
+                    ColliderBuilder::cuboid(
+                        c.length as f32 / 2.0,
+                        (c.width * 0.8) as f32 / 2.0,
+                        frame_height as f32 / 2.0,
+                    ),
+                );
+            }
+        }
+
+        // The touch sensor: a solid end stop the lumber runs into, and a thin sensing zone
+        // in front of its face.
+        let s = cell.touch_sensor;
+        let half = |v: f64| v as f32 / 2.0;
+        add_fixed(
+            &mut world,
+            &mut names,
+            "touch sensor",
+            s.pose,
+            ColliderBuilder::cuboid(half(s.size[0]), half(s.size[1]), half(s.size[2])),
+        );
+        let zone = s.pose * Isometry3::translation(-(s.size[0] + SENSOR_REACH) / 2.0, 0.0, 0.0);
+        let (_, sensor) = world.insert(
+            RigidBodyBuilder::fixed().pose(to_pose(&zone)),
+            ColliderBuilder::cuboid(half(SENSOR_REACH * 2.0), half(s.size[1]), half(s.size[2]))
+                .sensor(true)
+                .collision_groups(groups(SENSOR, LUMBER)),
+        );
+        names.insert(sensor, "touch sensor zone".into());
+
+        // The tool table: a top on four legs.
+        let t = cell.tool_table;
+        let top = Isometry3::translation(
+            t.top_centre.x,
+            t.top_centre.y,
+            t.top_centre.z - t.size[2] / 2.0,
+        );
+        add_fixed(
+            &mut world,
+            &mut names,
+            "tool table",
+            top,
+            ColliderBuilder::cuboid(half(t.size[0]), half(t.size[1]), half(t.size[2])),
+        );
+        let leg = 0.05;
+        let leg_height = t.top_centre.z - t.size[2] - f.z;
+        if leg_height > 0.01 {
+            for (sx, sy) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
+                let pose = Isometry3::translation(
+                    t.top_centre.x + sx * (t.size[0] / 2.0 - leg),
+                    t.top_centre.y + sy * (t.size[1] / 2.0 - leg),
+                    f.z + leg_height / 2.0,
+                );
+                add_fixed(
+                    &mut world,
+                    &mut names,
+                    "tool table leg",
+                    pose,
+                    ColliderBuilder::cuboid(half(leg), half(leg), half(leg_height)),
+                );
+            }
+        }
+
+        // The robot: one position-driven body per link with collision shapes; the base does
+        // not touch the floor it stands on.
+        let robot_types = ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED;
+        let poses = cell.robot.fk_all(q);
+        let mut links = Vec::new();
+        let mut robot_colliders = Vec::new();
+        for (i, link) in cell.robot.links.iter().enumerate() {
+            if link.collisions.is_empty() {
+                continue;
+            }
+            let body = world.insert_body(
+                RigidBodyBuilder::kinematic_position_based()
+                    .pose(to_pose(&(cell.robot_base * poses[i]))),
+            );
+            let filter = if i == 0 { LUMBER } else { FIXED | LUMBER };
+            for shape in &link.collisions {
+                let c = world.insert_collider(
+                    collider(shape)
+                        .collision_groups(groups(ROBOT, filter))
+                        .active_collision_types(robot_types),
+                    Some(body),
+                );
+                names.insert(c, link.name.clone());
+                robot_colliders.push(c);
+            }
+            links.push((i, body));
+        }
+
+        // The tool on the flange; gripper jaws become two finger plates each, which open and
+        // close with the gripper.
+        let tool_pose = cell.robot_base * cell.robot.fk_tip(q);
+        let tool = world
+            .insert_body(RigidBodyBuilder::kinematic_position_based().pose(to_pose(&tool_pose)));
+        let mut fingers = Vec::new();
+        let open = cell.tool.gripper.as_ref().map_or(0.1, |g| g.open_width);
+        for part in &cell.tool.parts {
+            let name = format!("tool {}", part.name);
+            match (&part.shape.shape, part.name.ends_with("_jaws")) {
+                (Shape::Box { half_extents: h }, true) => {
+                    for side in [-1.0, 1.0] {
+                        let finger = Finger {
+                            collider: ColliderHandle::invalid(),
+                            centre: part.shape.origin,
+                            side,
+                        };
+                        let c = world.insert_collider(
+                            ColliderBuilder::cuboid(half(FINGER), h[1] as f32, h[2] as f32)
+                                .position(to_pose(&finger.offset(open)))
+                                .collision_groups(groups(ROBOT, FIXED | LUMBER))
+                                .active_collision_types(robot_types),
+                            Some(tool),
+                        );
+                        names.insert(c, format!("{name} finger"));
+                        robot_colliders.push(c);
+                        fingers.push(Finger {
+                            collider: c,
+                            ..finger
+                        });
+                    }
+                }
+                _ => {
+                    let c = world.insert_collider(
+                        collider(&part.shape)
+                            .collision_groups(groups(ROBOT, FIXED | LUMBER))
+                            .active_collision_types(robot_types),
+                        Some(tool),
+                    );
+                    names.insert(c, name);
+                    robot_colliders.push(c);
+                }
+            }
+        }
+
+        Physics {
+            world,
+            belts: Belts {
+                belts,
+                running: true,
+            },
+            links,
+            tool,
+            fingers,
+            robot_colliders,
+            sensor,
+            lumber: BTreeMap::new(),
+            names,
+            lumber_of: HashMap::new(),
+            cell: cell.clone(),
+        }
+    }
+
+    /// Puts a lumber piece into the world at `pose` (cell frame), at rest.
+    pub fn add_lumber(&mut self, piece: &ScenePiece, pose: &Isometry3<f64>) {
+        let [l, w, t] = piece.size.map(|v| v as f32 / 2.0);
+        // Lumber on a belt never sleeps: the slow infeed belt moves it below rapier's sleep
+        // threshold. Placed pieces may sleep again (see `detach`).
+        let body = self.world.insert_body(
+            RigidBodyBuilder::dynamic()
+                .pose(to_pose(pose))
+                .can_sleep(false),
+        );
+        let collider = self.world.insert_collider(
+            ColliderBuilder::cuboid(l, w, t)
+                .density(piece.density as f32)
+                .friction(LUMBER_FRICTION)
+                .collision_groups(groups(LUMBER, FIXED | LUMBER | ROBOT | SENSOR))
+                .active_collision_types(
+                    ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED,
+                ),
+            Some(body),
+        );
+        self.names.insert(collider, format!("piece {}", piece.id));
+        self.lumber_of.insert(collider, piece.id.clone());
+        self.lumber
+            .insert(piece.id.clone(), LumberBody { body, collider });
+    }
+
+    /// Takes a piece out of the world (an operator lifts it off the belt).
+    pub fn remove_lumber(&mut self, id: &str) {
+        if let Some(b) = self.lumber.remove(id) {
+            self.world.remove_body_with_colliders(b.body, true);
+            self.lumber_of.remove(&b.collider);
+        }
+    }
+
+    pub fn lumber_pose(&self, id: &str) -> Option<Isometry3<f64>> {
+        let b = self.lumber.get(id)?;
+        Some(to_iso(self.world.bodies[b.body].position()))
+    }
+
+    /// Moves the robot's bodies to joint values `q` by the end of the next step.
+    pub fn drive_robot(&mut self, q: &[f64]) {
+        let poses = self.cell.robot.fk_all(q);
+        for &(i, body) in &self.links {
+            let pose = to_pose(&(self.cell.robot_base * poses[i]));
+            self.world.bodies[body].set_next_kinematic_position(pose);
+        }
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(q);
+        self.world.bodies[self.tool].set_next_kinematic_position(to_pose(&tool));
+    }
+
+    /// Opens the jaws (`None`) or closes them on lumber of this thickness.
+    pub fn set_jaws(&mut self, closed_on: Option<f64>) {
+        let open = self
+            .cell
+            .tool
+            .gripper
+            .as_ref()
+            .map_or(0.1, |g| g.open_width);
+        let width = closed_on.unwrap_or(open);
+        for f in &self.fingers {
+            if let Some(c) = self.world.colliders.get_mut(f.collider) {
+                c.set_position_wrt_parent(to_pose(&f.offset(width)));
+            }
+        }
+    }
+
+    /// Holds a piece rigidly in the gripper: it becomes position-driven (it follows the tool).
+    pub fn attach(&mut self, id: &str) {
+        if let Some(b) = self.lumber.get(id) {
+            self.world.bodies[b.body].set_body_type(RigidBodyType::KinematicPositionBased, true);
+        }
+    }
+
+    /// Lets go of a piece: it is a dynamic body again, at rest where it is.
+    pub fn detach(&mut self, id: &str) {
+        if let Some(b) = self.lumber.get(id) {
+            let body = &mut self.world.bodies[b.body];
+            body.set_body_type(RigidBodyType::Dynamic, true);
+            let activation = body.activation_mut();
+            activation.normalized_linear_threshold =
+                RigidBodyActivation::default_normalized_linear_threshold();
+            activation.angular_threshold = RigidBodyActivation::default_angular_threshold();
+            activation.time_until_sleep = RigidBodyActivation::default_time_until_sleep();
+            body.set_linvel(Vector::ZERO, true);
+            body.set_angvel(Vector::ZERO, true);
+        }
+    }
+
+    /// Moves a held piece with the tool by the end of the next step.
+    pub fn carry(&mut self, id: &str, pose: &Isometry3<f64>) {
+        if let Some(b) = self.lumber.get(id) {
+            self.world.bodies[b.body].set_next_kinematic_position(to_pose(pose));
+        }
+    }
+
+    /// Joins two pieces where they are (a nail).
+    pub fn nail(&mut self, a: &str, b: &str) {
+        let (Some(a), Some(b)) = (self.lumber.get(a).copied(), self.lumber.get(b).copied()) else {
+            return;
+        };
+        let pa = *self.world.bodies[a.body].position();
+        let pb = *self.world.bodies[b.body].position();
+        let joint = FixedJointBuilder::new()
+            .local_frame1(pa.inv_mul(&pb))
+            .local_frame2(Pose::IDENTITY)
+            .contacts_enabled(false);
+        self.world.insert_impulse_joint(a.body, b.body, joint);
+    }
+
+    /// Starts or stops both belts; a started belt wakes the lumber on it.
+    pub fn set_belts(&mut self, running: bool) {
+        if running && !self.belts.running {
+            let bodies: Vec<RigidBodyHandle> = self.lumber.values().map(|b| b.body).collect();
+            for b in bodies {
+                self.world.wake_up(b, true);
+            }
+        }
+        self.belts.running = running;
+    }
+
+    /// One physics step.
+    pub fn step(&mut self) {
+        self.world.step_with_events(&self.belts, &());
+    }
+
+    /// The lumber pieces in the sensor zone.
+    pub fn at_sensor(&self) -> Vec<String> {
+        let mut ids: Vec<String> = self
+            .world
+            .narrow_phase
+            .intersection_pairs_with(self.sensor)
+            .filter(|&(_, _, touching)| touching)
+            .filter_map(|(a, b, _)| {
+                let other = if a == self.sensor { b } else { a };
+                self.lumber_of.get(&other).cloned()
+            })
+            .collect();
+        ids.sort();
+        ids
+    }
+
+    /// Contacts of the robot, its tool and the piece `held` with anything else, deeper than
+    /// `tolerance`: (body, other body, depth), excluding the held piece against the tool.
+    pub fn robot_contacts(&self, held: Option<&str>, tolerance: f64) -> Vec<(String, String, f64)> {
+        let held_collider = held.and_then(|id| self.lumber.get(id)).map(|b| b.collider);
+        let mut found = Vec::new();
+        let mut sources = self.robot_colliders.clone();
+        sources.extend(held_collider);
+        for c in sources {
+            for pair in self.world.contact_pairs_with(c) {
+                let other = if pair.collider1 == c {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                };
+                if self.robot_colliders.contains(&other) || Some(other) == held_collider {
+                    continue;
+                }
+                let Some((_, contact)) = pair.find_deepest_contact() else {
+                    continue;
+                };
+                let depth = -f64::from(contact.dist);
+                if depth > tolerance {
+                    found.push((self.name(c), self.name(other), depth));
+                }
+            }
+        }
+        found
+    }
+
+    pub fn name(&self, c: ColliderHandle) -> String {
+        self.names.get(&c).cloned().unwrap_or_else(|| "?".into())
+    }
+
+    /// Current pose of every piece in the world.
+    pub fn lumber_poses(&self) -> BTreeMap<String, Isometry3<f64>> {
+        self.lumber
+            .iter()
+            .map(|(id, b)| (id.clone(), to_iso(self.world.bodies[b.body].position())))
+            .collect()
+    }
+}
+
+impl Finger {
+    /// The finger's pose in tool0 when the jaws stand `width` apart.
+    fn offset(&self, width: f64) -> Isometry3<f64> {
+        self.centre * Isometry3::translation(self.side * (width + FINGER) / 2.0, 0.0, 0.0)
+    }
+}
+
+/// A rapier collider builder for a placed primitive (cylinders and capsules along local z).
+pub fn collider(shape: &PlacedShape) -> ColliderBuilder {
+    // rapier's cylinders run along y: turn them onto z.
+    let y_to_z = Isometry3::from_parts(
+        Translation3::identity(),
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+    );
+    let (builder, pose) = match shape.shape {
+        Shape::Box { half_extents: h } => (
+            ColliderBuilder::cuboid(h[0] as f32, h[1] as f32, h[2] as f32),
+            shape.origin,
+        ),
+        Shape::Cylinder { radius, length } => (
+            ColliderBuilder::cylinder(length as f32 / 2.0, radius as f32),
+            shape.origin * y_to_z,
+        ),
+        Shape::Capsule { radius, length } => (
+            ColliderBuilder::capsule_z(length as f32 / 2.0, radius as f32),
+            shape.origin,
+        ),
+        Shape::Sphere { radius } => (ColliderBuilder::ball(radius as f32), shape.origin),
+    };
+    builder.position(to_pose(&pose))
+}

@@ -1,0 +1,141 @@
+//! Inverse kinematics and collision checks the executor plans with: the robot's IK in the
+//! cell frame, straight-line feasibility, and whether the arm, its tool and a held piece
+//! would intersect anything at given joint values (parry queries on the rapier world).
+
+use super::physics::{Physics, to_pose};
+use crate::cell::{Cell, IkFailure};
+use nalgebra::Isometry3;
+use rapier3d::prelude::*;
+
+/// The largest joint step (rad or m) between two samples of a straight line before the
+/// line counts as jumping between IK branches.
+const MAX_BRANCH_STEP: f64 = 0.35;
+
+/// The closest IK solution to `seed` for a TCP pose in the cell frame.
+pub fn solve(
+    cell: &Cell,
+    pose_cell: &Isometry3<f64>,
+    tcp: &Isometry3<f64>,
+    seed: &[f64],
+) -> Result<Vec<f64>, IkFailure> {
+    let pose = cell.to_robot(pose_cell);
+    let mut solutions = cell.robot.ik(&pose, tcp, seed)?;
+    Ok(solutions.swap_remove(0))
+}
+
+/// How far inside the arm's reach a TCP pose lies (m): the closed-form wrist-centre margin,
+/// else the rated reach minus the tip's distance from the base.
+pub fn reach_margin(cell: &Cell, pose_cell: &Isometry3<f64>, tcp: &Isometry3<f64>) -> f64 {
+    let pose = cell.to_robot(pose_cell);
+    cell.robot.reach_margin(&pose, tcp).unwrap_or_else(|| {
+        let reach = cell.robot.meta.reach.unwrap_or(f64::INFINITY);
+        reach - (pose * tcp.inverse()).translation.vector.norm()
+    })
+}
+
+/// Joint values at the end of a straight TCP line from `q_from` (at `from`) to `to`, checked
+/// at `samples` points along the way (each the solution closest to the previous one).
+pub fn line(
+    cell: &Cell,
+    q_from: &[f64],
+    from: &Isometry3<f64>,
+    to: &Isometry3<f64>,
+    tcp: &Isometry3<f64>,
+    samples: usize,
+) -> Result<Vec<f64>, IkFailure> {
+    let mut q = q_from.to_vec();
+    for k in 1..=samples {
+        let s = k as f64 / samples as f64;
+        let t = from.translation.vector.lerp(&to.translation.vector, s);
+        let r = from.rotation.slerp(&to.rotation, s);
+        let next = solve(cell, &Isometry3::from_parts(t.into(), r), tcp, &q)?;
+        let jump = next
+            .iter()
+            .zip(&q)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        if jump > MAX_BRANCH_STEP && k > 1 {
+            return Err(IkFailure::NoExactSolution {
+                position_error: 0.0,
+                rotation_error: jump,
+            });
+        }
+        q = next;
+    }
+    Ok(q)
+}
+
+/// What the arm would touch at joint values `q` holding `held` (its id, its pose in tool0 and
+/// its box half sizes): the first (robot body, other body) pair found, ignoring the bodies
+/// in `ignore` and sensors.
+pub fn touches(
+    phys: &Physics,
+    cell: &Cell,
+    q: &[f64],
+    held: Option<(&str, &Isometry3<f64>, [f64; 3])>,
+    ignore: &[&str],
+) -> Option<(String, String)> {
+    let world = &phys.world;
+    let poses = cell.robot.fk_all(q);
+    let tool = cell.robot_base * cell.robot.fk_tip(q);
+    let mut excluded: Vec<RigidBodyHandle> = phys.links.iter().map(|l| l.1).collect();
+    excluded.push(phys.tool);
+    for id in ignore.iter().copied().chain(held.map(|h| h.0)) {
+        if let Some(b) = phys.lumber.get(id) {
+            excluded.push(b.body);
+        }
+    }
+    let skip = |_: ColliderHandle, c: &Collider| {
+        c.is_sensor() || c.parent().is_some_and(|b| excluded.contains(&b))
+    };
+    let predicate = |h: ColliderHandle, c: &Collider| !skip(h, c);
+    let hit = |pose: Isometry3<f64>, shape: &dyn rapier3d::parry::shape::Shape, filter| {
+        world
+            .intersect_shape(to_pose(&pose), shape, filter)
+            .map(|(h, _)| phys.name(h))
+            .next()
+    };
+    let body_pose = |body: RigidBodyHandle| -> Option<Isometry3<f64>> {
+        if body == phys.tool {
+            return Some(tool);
+        }
+        let &(i, _) = phys.links.iter().find(|l| l.1 == body)?;
+        Some(cell.robot_base * poses[i])
+    };
+    for &c in &phys.robot_colliders {
+        let collider = &world.colliders[c];
+        let Some(parent) = collider.parent() else {
+            continue;
+        };
+        // The base never moves and stands on the floor.
+        if phys
+            .links
+            .first()
+            .is_some_and(|l| l.1 == parent && l.0 == 0)
+        {
+            continue;
+        }
+        let Some(body) = body_pose(parent) else {
+            continue;
+        };
+        let local = collider
+            .position_wrt_parent()
+            .map_or_else(Isometry3::identity, super::physics::to_iso);
+        let filter = QueryFilter::default()
+            .groups(collider.collision_groups())
+            .predicate(&predicate);
+        if let Some(other) = hit(body * local, collider.shape(), filter) {
+            return Some((phys.name(c), other));
+        }
+    }
+    if let Some((id, in_tool, half)) = held {
+        // Shrunk by 2 mm: a placed piece may touch its neighbours.
+        let h = half.map(|v| (v - 0.002).max(0.001) as f32);
+        let shape = Cuboid::new(Vector::new(h[0], h[1], h[2]));
+        let filter = QueryFilter::default().predicate(&predicate);
+        if let Some(other) = hit(tool * in_tool, &shape, filter) {
+            return Some((format!("piece {id}"), other));
+        }
+    }
+    None
+}

@@ -1,0 +1,280 @@
+//! What the executor records while it runs a wall, and those records as the input facts of
+//! `rules/sim.dl`.
+
+use crate::cell::IkFailure;
+use crate::frame::Facts;
+use crate::logic::{Origin, Value};
+use serde::Serialize;
+
+/// One operation on an element.
+#[derive(Debug, Clone, Serialize)]
+pub struct Operation {
+    pub piece: String,
+    pub op: &'static str,
+    pub start: f64,
+    pub end: f64,
+}
+
+/// An IK answer for an operation's pose.
+#[derive(Debug, Clone, Serialize)]
+pub struct IkRecord {
+    pub piece: String,
+    pub op: &'static str,
+    pub result: Result<f64, IkFailure>,
+}
+
+/// A contact of the robot, its tool or the held piece with something else.
+#[derive(Debug, Clone, Serialize)]
+pub struct ContactRecord {
+    pub piece: String,
+    pub op: &'static str,
+    /// First time of the contact in this operation.
+    pub t: f64,
+    pub body_a: String,
+    pub body_b: String,
+    /// Deepest penetration seen in this operation, m.
+    pub depth: f64,
+}
+
+/// A placed piece's rest pose against its target.
+#[derive(Debug, Clone, Serialize)]
+pub struct Placement {
+    pub piece: String,
+    pub position_error: f64,
+    pub angle_error: f64,
+}
+
+/// A nail of the plan and what became of it.
+#[derive(Debug, Clone, Serialize)]
+pub struct NailRecord {
+    pub plate: String,
+    pub member: String,
+    pub k: i64,
+    /// Planned wall coordinates.
+    pub planned: [f64; 3],
+    pub outcome: NailOutcome,
+}
+
+#[derive(Debug, Clone, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum NailOutcome {
+    Fired {
+        t: f64,
+        /// The planned point carried by the as-built plate, in wall coordinates.
+        as_built: [f64; 3],
+        position_error: f64,
+        member_inside: bool,
+    },
+    Skipped {
+        kind: String,
+        what: String,
+        value: f64,
+        limit: f64,
+        message: String,
+    },
+}
+
+/// A belt starting or stopping.
+#[derive(Debug, Clone, Serialize)]
+pub struct BeltEvent {
+    pub t: f64,
+    pub belt: &'static str,
+    pub event: &'static str,
+    pub piece: String,
+}
+
+/// Everything recorded for one wall.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct WallRecord {
+    pub wall: String,
+    pub operations: Vec<Operation>,
+    pub ik: Vec<IkRecord>,
+    pub contacts: Vec<ContactRecord>,
+    pub placements: Vec<Placement>,
+    pub fed: Vec<(String, f64)>,
+    pub not_fed: Vec<(String, String)>,
+    pub grip_failed: Vec<(String, String)>,
+    pub nails: Vec<NailRecord>,
+    pub belt_events: Vec<BeltEvent>,
+    pub framing_end: f64,
+    pub nailing_end: f64,
+    /// Physics steps taken.
+    pub steps: u64,
+}
+
+/// The `what`, value and limit columns of an IK failure.
+pub fn failure_columns(f: &IkFailure) -> (&'static str, String, f64, f64) {
+    match f {
+        IkFailure::OutOfReach {
+            distance, reach, ..
+        } => ("out_of_reach", String::new(), *distance, *reach),
+        IkFailure::JointLimit {
+            joint,
+            value,
+            limit,
+            ..
+        } => ("joint_limit", joint.clone(), *value, *limit),
+        IkFailure::WristSingularity { margin, required } => {
+            ("wrist_singularity", String::new(), *margin, *required)
+        }
+        IkFailure::AllSolutionsCollide { pair } => (
+            "all_solutions_collide",
+            format!("{} / {}", pair[0], pair[1]),
+            0.0,
+            0.0,
+        ),
+        IkFailure::NoExactSolution {
+            position_error,
+            rotation_error,
+        } => (
+            "no_exact_solution",
+            String::new(),
+            *position_error,
+            *rotation_error,
+        ),
+        IkFailure::InvalidPose => ("invalid_pose", String::new(), 0.0, 0.0),
+    }
+}
+
+impl WallRecord {
+    /// The records as facts of `rules/sim.dl`, each tuple's origin naming the event.
+    pub fn facts(&self) -> Facts {
+        let mut facts = Facts::default();
+        let s = Value::sym;
+        let f = Value::float;
+        let event = |what: &str| Origin::Event(format!("{} {what}", self.wall));
+        for o in &self.operations {
+            facts.add(
+                "sim_operation",
+                vec![s(&o.piece), s(o.op), f(o.start), f(o.end)],
+                event(&format!("{} of {} at t = {:.3} s", o.op, o.piece, o.start)),
+            );
+        }
+        for r in &self.ik {
+            let origin = event(&format!("IK for {} of {}", r.op, r.piece));
+            match &r.result {
+                Ok(margin) => facts.add(
+                    "sim_ik_solved",
+                    vec![s(&r.piece), s(r.op), f(*margin)],
+                    origin,
+                ),
+                Err(failure) => {
+                    let (kind, what, value, limit) = failure_columns(failure);
+                    facts.add(
+                        "sim_ik_failed",
+                        vec![
+                            s(&r.piece),
+                            s(r.op),
+                            s(kind),
+                            s(&what),
+                            f(value),
+                            f(limit),
+                            s(&failure.to_string()),
+                        ],
+                        origin,
+                    );
+                }
+            }
+        }
+        for c in &self.contacts {
+            facts.add(
+                "sim_contact",
+                vec![
+                    s(&c.piece),
+                    s(c.op),
+                    f(c.t),
+                    s(&c.body_a),
+                    s(&c.body_b),
+                    f(c.depth),
+                ],
+                event(&format!(
+                    "contact {} / {} at t = {:.3} s",
+                    c.body_a, c.body_b, c.t
+                )),
+            );
+        }
+        for p in &self.placements {
+            facts.add(
+                "sim_placed",
+                vec![s(&p.piece), f(p.position_error), f(p.angle_error)],
+                event(&format!("rest pose of {}", p.piece)),
+            );
+        }
+        for (p, t) in &self.fed {
+            facts.add(
+                "sim_fed",
+                vec![s(p), f(*t)],
+                event(&format!("{p} at the sensor")),
+            );
+        }
+        for (p, why) in &self.not_fed {
+            facts.add(
+                "sim_not_fed",
+                vec![s(p), s(why)],
+                event(&format!("{p} not fed")),
+            );
+        }
+        for (p, why) in &self.grip_failed {
+            facts.add(
+                "sim_grip_failed",
+                vec![s(p), s(why)],
+                event(&format!("grip of {p}")),
+            );
+        }
+        for n in &self.nails {
+            let key = || vec![s(&n.plate), s(&n.member), Value::Number(n.k)];
+            let origin = || event(&format!("nail {} -> {} #{}", n.plate, n.member, n.k));
+            let mut planned = key();
+            planned.extend(n.planned.map(f));
+            facts.add("sim_nail", planned, origin());
+            match &n.outcome {
+                NailOutcome::Fired {
+                    t,
+                    as_built,
+                    position_error,
+                    member_inside,
+                } => {
+                    let mut fired = key();
+                    fired.extend([
+                        f(*t),
+                        f(*position_error),
+                        Value::Number(i64::from(*member_inside)),
+                    ]);
+                    facts.add("sim_nail_fired", fired, origin());
+                    let mut built = key();
+                    built.extend(as_built.map(f));
+                    facts.add("sim_nail_as_built", built, origin());
+                }
+                NailOutcome::Skipped {
+                    kind,
+                    what,
+                    value,
+                    limit,
+                    message,
+                } => {
+                    let mut skipped = key();
+                    skipped.extend([s(kind), s(what), f(*value), f(*limit), s(message)]);
+                    facts.add("sim_nail_skipped", skipped, origin());
+                }
+            }
+        }
+        facts.add(
+            "sim_wall",
+            vec![
+                s(&self.wall),
+                f(0.0),
+                f(self.framing_end),
+                f(self.nailing_end),
+            ],
+            event("run"),
+        );
+        for b in &self.belt_events {
+            facts.add(
+                "sim_belt_event",
+                vec![s(&self.wall), f(b.t), s(b.belt), s(b.event), s(&b.piece)],
+                event(&format!("{} {} at t = {:.3} s", b.belt, b.event, b.t)),
+            );
+        }
+        facts
+    }
+}
