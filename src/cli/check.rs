@@ -8,6 +8,7 @@ use framewright::frame::cell_facts::cell_facts;
 use framewright::frame::{Facts, RuleEngine, model_facts, reason};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
+use framewright::sim::{SimOptions, simulate};
 use framewright::user_rules::{Finding, Findings, UserRules};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -33,6 +34,12 @@ pub struct CheckArgs {
     /// Largest gap between two pieces still taken as touching, millimetres.
     #[arg(long, value_name = "MM", default_value_t = 3.0)]
     pub contact_tolerance: f64,
+    /// Simulate the walls first, so rules can read the executor's facts (sim_*) and verdicts.
+    #[arg(long)]
+    pub simulate: bool,
+    /// With --simulate: only this wall (id or name); repeat for more.
+    #[arg(long = "wall", value_name = "W", requires = "simulate")]
+    pub walls: Vec<String>,
 }
 
 /// The model, the cell and their facts (what plan, check and why start from).
@@ -87,8 +94,23 @@ pub fn run(args: CheckArgs) -> CmdResult {
     // Rule files first: a typo fails before the model is read.
     let user = UserRules::load(&args.rules, &base)?;
     let (model, cell, facts) = load_inputs(&args.model, &args.cell, args.contact_tolerance)?;
-    let reasoned = reason(&facts, &base, false)?;
-    let findings = user.evaluate(&reasoned.relations)?;
+    let findings = if args.simulate {
+        if args.contact_tolerance != 3.0 {
+            return Err(Failure::bad_input(
+                "--contact-tolerance cannot be combined with --simulate (the executor plans with the default tolerance)",
+            ));
+        }
+        let options = SimOptions {
+            walls: args.walls.clone(),
+            engine: base.clone(),
+            ..SimOptions::default()
+        };
+        let sim = simulate(&model, &cell, &options)?;
+        user.evaluate(&sim.reasoned.relations)?
+    } else {
+        let reasoned = reason(&facts, &base, false)?;
+        user.evaluate(&reasoned.relations)?
+    };
     report(&args, &model, &cell.name, &findings)
 }
 

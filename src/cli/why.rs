@@ -6,7 +6,8 @@
 use super::check::{load_inputs, rule_base};
 use super::{CmdResult, Failure, print_stdout};
 use framewright::user_rules::render::{render_why, render_why_not};
-use framewright::user_rules::why::{Context, WhyError, why, why_not};
+use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
+use framewright::user_rules::why::{Context, WhyError, element_walls, why, why_not};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -47,6 +48,61 @@ pub struct Common {
     /// Largest gap between two pieces still taken as touching, millimetres.
     #[arg(long, value_name = "MM", default_value_t = 3.0)]
     pub contact_tolerance: f64,
+    /// Explain the plan only: do not simulate the element's wall.
+    #[arg(long)]
+    pub no_simulate: bool,
+    /// Where simulated walls are cached (default: $FRAMEWRIGHT_CACHE, $XDG_CACHE_HOME/framewright or ~/.cache/framewright).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+}
+
+/// A wall simulated for the explanation.
+#[derive(Serialize)]
+struct Simulated {
+    wall: String,
+    from_cache: bool,
+}
+
+/// Adds the executor's facts of the walls of the pieces in `ids` (each wall
+/// simulated once, then cached), unless `--no-simulate`.
+fn simulate_walls(
+    c: &Common,
+    model_path: &std::path::Path,
+    model: &framewright::ifc::Model,
+    cell: &framewright::cell::Cell,
+    facts: &mut framewright::frame::Facts,
+    ids: &[String],
+) -> Result<Vec<Simulated>, Failure> {
+    if c.no_simulate {
+        return Ok(Vec::new());
+    }
+    let base = rule_base(&c.rules_dir);
+    let ctx = Context {
+        model,
+        facts,
+        base: &base,
+        user_files: &c.rules,
+    };
+    let mut walls = Vec::new();
+    for id in ids {
+        for w in element_walls(&ctx, id).map_err(failure)? {
+            if !walls.contains(&w) {
+                walls.push(w);
+            }
+        }
+    }
+    let cache = c.cache_dir.clone().or_else(default_cache_dir);
+    let mut out = Vec::new();
+    for wall in walls {
+        let (sim, cached) =
+            wall_sim_facts(model_path, model, cell, &wall, &base, cache.as_deref())?;
+        facts.extend(sim);
+        out.push(Simulated {
+            wall,
+            from_cache: cached,
+        });
+    }
+    Ok(out)
 }
 
 #[derive(Serialize)]
@@ -72,7 +128,15 @@ fn failure(e: WhyError) -> Failure {
 pub fn run_why(args: WhyArgs) -> CmdResult {
     let c = &args.common;
     let base = rule_base(&c.rules_dir);
-    let (model, cell, facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let (model, cell, mut facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let simulated = simulate_walls(
+        c,
+        &args.model,
+        &model,
+        &cell,
+        &mut facts,
+        std::slice::from_ref(&args.id),
+    )?;
     let ctx = Context {
         model: &model,
         facts: &facts,
@@ -82,17 +146,37 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     let reports = why(&ctx, &args.id).map_err(failure)?;
     let text = if c.json {
         #[derive(Serialize)]
-        struct Elements<T> {
+        struct Elements<'a, T> {
+            simulated: &'a [Simulated],
             elements: T,
         }
         json(&Envelope {
             model: args.model.display().to_string(),
             cell: &cell.name,
             query: &args.id,
-            answer: Elements { elements: &reports },
+            answer: Elements {
+                simulated: &simulated,
+                elements: &reports,
+            },
         })?
     } else {
-        render_why(&reports)
+        let mut text = String::new();
+        for s in &simulated {
+            text.push_str(&format!(
+                "simulated wall {}{}\n",
+                s.wall,
+                if s.from_cache {
+                    " (from the cache)"
+                } else {
+                    ""
+                }
+            ));
+        }
+        if c.no_simulate {
+            text.push_str("not simulated (--no-simulate): plan verdicts only\n");
+        }
+        text.push_str(&render_why(&reports));
+        text
     };
     print_stdout(&text)
 }
@@ -100,7 +184,9 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
 pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     let c = &args.common;
     let base = rule_base(&c.rules_dir);
-    let (model, cell, facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let (model, cell, mut facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let ids = piece_ids_in(&model, &args.tuple);
+    simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
     let ctx = Context {
         model: &model,
         facts: &facts,
@@ -119,4 +205,26 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
         render_why_not(&args.tuple, &report)
     };
     print_stdout(&text)
+}
+
+/// The pieces a why-not tuple names (`#entity` or a piece id), as IDs for `why`.
+fn piece_ids_in(model: &framewright::ifc::Model, tuple: &str) -> Vec<String> {
+    let inner = tuple
+        .split_once('(')
+        .map_or("", |(_, r)| r)
+        .trim_end_matches(')');
+    let mut ids = Vec::new();
+    for arg in inner.split(',') {
+        let arg = arg.trim().trim_matches('"');
+        let known = if let Some(n) = arg.strip_prefix('#') {
+            n.parse::<u64>()
+                .is_ok_and(|n| model.pieces().iter().any(|p| p.entity == n || p.item == n))
+        } else {
+            model.pieces().iter().any(|p| p.id == arg)
+        };
+        if known && !ids.iter().any(|i| i == arg) {
+            ids.push(arg.to_string());
+        }
+    }
+    ids
 }

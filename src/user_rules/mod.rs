@@ -16,6 +16,7 @@
 
 pub mod relations_doc;
 pub mod render;
+pub mod sim_cache;
 pub mod why;
 
 use crate::frame::RuleEngine;

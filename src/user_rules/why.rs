@@ -45,6 +45,9 @@ pub enum WhyError {
     /// ids), or the query names no relation.
     #[error("{0}")]
     UnknownElement(String),
+    /// The rule base failed to run (a `--rules-dir` that does not check, say).
+    #[error("{0}")]
+    Frame(String),
 }
 
 /// What to explain against: the model's facts (with cell and, when
@@ -171,6 +174,23 @@ fn containers_of(facts: &Facts, ids: &BTreeSet<&str>) -> BTreeSet<String> {
         .filter(|(t, _)| t[0].as_symbol().is_some_and(|p| ids.contains(p)))
         .filter_map(|(t, _)| t[1].as_symbol().map(str::to_string))
         .collect()
+}
+
+/// The walls (keys, as in `wall_of`) of the pieces an ID names, from the
+/// rule base run over their containers only.
+pub fn element_walls(ctx: &Context<'_>, id: &str) -> Result<Vec<String>, WhyError> {
+    let pieces = resolve_element(ctx.model, id)?;
+    let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
+    let facts = restrict_to_containers(ctx.facts, &containers_of(ctx.facts, &ids));
+    let reasoned = crate::frame::reason(&facts, ctx.base, false)
+        .map_err(|e| WhyError::Frame(e.to_string()))?;
+    let walls: BTreeSet<String> = reasoned
+        .get("wall_of")
+        .iter()
+        .filter(|t| t[0].as_symbol().is_some_and(|p| ids.contains(p)))
+        .filter_map(|t| t[1].as_symbol().map(str::to_string))
+        .collect();
+    Ok(walls.into_iter().collect())
 }
 
 /// Runs the base (+ user rules) with provenance over `facts`.
