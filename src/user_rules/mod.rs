@@ -48,6 +48,21 @@ pub enum UserRulesError {
     Logic(#[from] LogicError),
     #[error("{}: cannot read the rules directory: {message}", path.display())]
     RulesDir { path: PathBuf, message: String },
+    #[error("cannot read rule file {}: {message}; check the path", path.display())]
+    RuleFile { path: PathBuf, message: String },
+}
+
+/// Every user file must be readable (checked up front for a plain message).
+fn check_readable(files: &[PathBuf]) -> Result<(), UserRulesError> {
+    for f in files {
+        if let Err(e) = std::fs::read(f) {
+            return Err(UserRulesError::RuleFile {
+                path: f.clone(),
+                message: e.to_string(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// One finding of a user rule.
@@ -92,6 +107,7 @@ impl UserRules {
     /// (`RuleEngine::Compiled`/`Interpreted`) or a rules directory
     /// (`RuleEngine::Directory`).
     pub fn load(files: &[PathBuf], base: &RuleEngine) -> Result<UserRules, UserRulesError> {
+        check_readable(files)?;
         let base_program = base_program(base)?;
         refuse_redeclarations(files, &base_program)?;
         let sigs = functors::signatures();
@@ -213,6 +229,7 @@ pub fn base_program(base: &RuleEngine) -> Result<Program, UserRulesError> {
 /// Base rules + findings declarations + user files as one checked program
 /// (user files refused when they redefine a base relation).
 pub fn full_program(base: &RuleEngine, user_files: &[PathBuf]) -> Result<Program, UserRulesError> {
+    check_readable(user_files)?;
     let base_prog = base_program(base)?;
     refuse_redeclarations(user_files, &base_prog)?;
     let sigs = functors::signatures();

@@ -328,10 +328,10 @@ pub fn sources_of(e: &Explanation) -> Sources {
                 rules.insert(rule.clone());
             }
             How::Input { origin } => {
-                if node.relation.starts_with("cell_") {
-                    if let Some(k) = node.tuple.first().and_then(Value::as_symbol) {
-                        keys.insert(k.to_string());
-                    }
+                if node.relation.starts_with("cell_")
+                    && let Some(k) = node.tuple.first().and_then(Value::as_symbol)
+                {
+                    keys.insert(k.to_string());
                 }
                 if node.relation.starts_with("sim_") {
                     s.simulation_facts += 1;
