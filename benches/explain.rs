@@ -4,6 +4,8 @@
 //!   ratio is the cost of the rules: `check` reads, reasons, then evaluates
 //!   the user rules over the relations they read; `plan` reasons and builds
 //!   the typed plan);
+//! - `reason_only`: what `check` does before the user rules, so
+//!   `check_5_rules - reason_only` is the cost of the rules themselves;
 //! - `why` for one element without simulation (read, facts, rule base with
 //!   provenance over the element's storey, explanations).
 //!
@@ -39,6 +41,15 @@ fn plan(path: &Path, cell: &Cell) -> usize {
     let (model, facts) = inputs(path, cell);
     let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");
     Plan::from_reasoned(&model, &reasoned).walls.len()
+}
+
+/// What `check` does before the user rules: read, facts, compiled rule base.
+fn reason_only(path: &Path, cell: &Cell) -> usize {
+    let (_, facts) = inputs(path, cell);
+    reason(&facts, &RuleEngine::Compiled, false)
+        .expect("reason")
+        .get("wall")
+        .len()
 }
 
 fn check(path: &Path, cell: &Cell, files: &[PathBuf]) -> usize {
@@ -79,6 +90,9 @@ fn benches(c: &mut Criterion) {
     for (name, path) in &models {
         group.bench_function(format!("plan/{name}"), |b| {
             b.iter(|| black_box(plan(path, &cell)))
+        });
+        group.bench_function(format!("reason_only/{name}"), |b| {
+            b.iter(|| black_box(reason_only(path, &cell)))
         });
         group.bench_function(format!("check_5_rules/{name}"), |b| {
             b.iter(|| black_box(check(path, &cell, &files)))

@@ -93,24 +93,27 @@ pub fn run(args: CheckArgs) -> CmdResult {
     let base = rule_base(&args.rules_dir);
     // Rule files first: a typo fails before the model is read.
     let user = UserRules::load(&args.rules, &base)?;
-    let (model, cell, facts) = load_inputs(&args.model, &args.cell, args.contact_tolerance)?;
-    let findings = if args.simulate {
+    if args.simulate {
         if args.contact_tolerance != 3.0 {
             return Err(Failure::bad_input(
                 "--contact-tolerance cannot be combined with --simulate (the executor plans with the default tolerance)",
             ));
         }
+        // The executor reads the model and reasons itself.
+        let model = Model::open(&args.model)?;
+        let cell = Cell::load(&args.cell)?;
         let options = SimOptions {
             walls: args.walls.clone(),
             engine: base.clone(),
             ..SimOptions::default()
         };
         let sim = simulate(&model, &cell, &options)?;
-        user.evaluate(&sim.reasoned.relations)?
-    } else {
-        let reasoned = reason(&facts, &base, false)?;
-        user.evaluate(&reasoned.relations)?
-    };
+        let findings = user.evaluate(&sim.reasoned.relations)?;
+        return report(&args, &model, &cell.name, &findings);
+    }
+    let (model, cell, facts) = load_inputs(&args.model, &args.cell, args.contact_tolerance)?;
+    let reasoned = reason(&facts, &base, false)?;
+    let findings = user.evaluate(&reasoned.relations)?;
     report(&args, &model, &cell.name, &findings)
 }
 
