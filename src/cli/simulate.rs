@@ -30,7 +30,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "DIR")]
     pub rules_dir: Option<PathBuf>,
     /// Physics time step, milliseconds.
-    #[arg(long, value_name = "MS", default_value_t = 1000.0 / 120.0)]
+    #[arg(long, value_name = "MS", default_value_t = 1000.0 / 240.0)]
     pub step_ms: f64,
     /// Fraction of the robot's joint speed and acceleration limits to move at (0..1].
     #[arg(long, default_value_t = 1.0)]

@@ -34,6 +34,9 @@ const LINE_SPEED: f64 = 0.25;
 const LINE_ACCEL: f64 = 1.0;
 /// How long placed pieces settle before their rest poses are measured (s).
 const SETTLE_TIME: f64 = 1.0;
+/// A piece that ran into the sensor's end stop settles this long before the robot plans its
+/// grip (s).
+const SENSOR_SETTLE: f64 = 0.5;
 
 /// One nail as the executor drives it.
 #[derive(Debug, Clone)]
@@ -94,9 +97,7 @@ struct FramingPlan {
     pick: Isometry3<f64>,
     place: Isometry3<f64>,
     q_above_pick: Vec<f64>,
-    q_pick: Vec<f64>,
     q_above_place: Vec<f64>,
-    q_place: Vec<f64>,
     pick_margin: f64,
     place_margin: f64,
     /// The target orientation actually used (a box has four equivalent ones).
@@ -263,6 +264,15 @@ impl<'a> WallRun<'a> {
         if self.path_clear(&direct, ignore) {
             return direct;
         }
+        // An arc about the robot's base that keeps the tool's orientation turning evenly
+        // (a held piece stays level) and rises over the middle.
+        for bump in [0.3, 0.7] {
+            if let Some(path) = self.arc(from, to, tcp, bump) {
+                if self.path_clear(&path, ignore) {
+                    return path;
+                }
+            }
+        }
         let up = |q: &[f64], h: f64| -> Option<Vec<f64>> {
             let pose = self.cell.robot_base * self.cell.robot.fk_tip(q) * tcp;
             let raised = Isometry3::from_parts(
@@ -271,16 +281,64 @@ impl<'a> WallRun<'a> {
             );
             solve(self.cell, &raised, tcp, q).ok()
         };
-        for h in [0.4, 0.8, 1.2] {
+        // Raised waypoints over both ends, then the same through the robot's home pose (a
+        // transit pose that turns the wrist high above the work).
+        let home = self.cell.robot.home();
+        for h in [0.4, 0.8] {
             let (Some(a), Some(b)) = (up(from, h), up(to, h)) else {
                 continue;
             };
-            let path = vec![from.to_vec(), a, b, to.to_vec()];
-            if self.path_clear(&path, ignore) {
-                return path;
+            for path in [
+                vec![from.to_vec(), a.clone(), b.clone(), to.to_vec()],
+                vec![from.to_vec(), a, home.clone(), b, to.to_vec()],
+            ] {
+                if self.path_clear(&path, ignore) {
+                    return path;
+                }
             }
         }
         direct
+    }
+
+    /// Joint waypoints along a TCP arc about the base from the pose at `from` to the pose at
+    /// `to`: radius, angle and height interpolated, the height raised by `bump` mid-way.
+    fn arc(
+        &self,
+        from: &[f64],
+        to: &[f64],
+        tcp: &Isometry3<f64>,
+        bump: f64,
+    ) -> Option<Vec<Vec<f64>>> {
+        let base = self.cell.robot_base;
+        let a = base * self.cell.robot.fk_tip(from) * tcp;
+        let b = base * self.cell.robot.fk_tip(to) * tcp;
+        let local = |p: &Isometry3<f64>| base.inverse() * Point3::from(p.translation.vector);
+        let (pa, pb) = (local(&a), local(&b));
+        let (ra, rb) = (pa.xy().coords.norm(), pb.xy().coords.norm());
+        let ta = pa.y.atan2(pa.x);
+        let mut tb = pb.y.atan2(pb.x);
+        while tb - ta > std::f64::consts::PI {
+            tb -= 2.0 * std::f64::consts::PI;
+        }
+        while ta - tb > std::f64::consts::PI {
+            tb += 2.0 * std::f64::consts::PI;
+        }
+        const SAMPLES: usize = 12;
+        let mut path = vec![from.to_vec()];
+        let mut q = from.to_vec();
+        for k in 1..SAMPLES {
+            let s = k as f64 / SAMPLES as f64;
+            let (r, th) = (ra + (rb - ra) * s, ta + (tb - ta) * s);
+            let z = pa.z + (pb.z - pa.z) * s + bump * (std::f64::consts::PI * s).sin();
+            let yaw = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), (tb - ta) * s);
+            let rotation = base.rotation * yaw * (base.rotation.inverse() * a.rotation);
+            let point = base * Point3::new(r * th.cos(), r * th.sin(), z);
+            let pose = Isometry3::from_parts(Translation3::from(point.coords), rotation);
+            q = solve(self.cell, &pose, tcp, &q).ok()?;
+            path.push(q.clone());
+        }
+        path.push(to.to_vec());
+        Some(path)
     }
 
     fn path_clear(&self, path: &[Vec<f64>], ignore: &[&str]) -> bool {
@@ -459,13 +517,11 @@ impl<'a> WallRun<'a> {
             if at.contains(&piece.id) && !self.phys.belts.running {
                 return Ok(());
             }
-            if let Some(other) = at
+            let other = at
                 .iter()
-                .find(|id| **id != piece.id && self.on_belts.contains(*id))
-            {
-                if !self.phys.belts.running {
-                    return Err(format!("{other} reached the sensor before it"));
-                }
+                .find(|id| **id != piece.id && self.on_belts.contains(*id));
+            if let (Some(other), false) = (other, self.phys.belts.running) {
+                return Err(format!("{other} reached the sensor before it"));
             }
             if self.t - start > limit {
                 let where_ = self
@@ -502,6 +558,7 @@ impl<'a> WallRun<'a> {
             return;
         }
         self.record.fed.push((piece.id.clone(), self.t));
+        self.wait(SENSOR_SETTLE);
         if let Err(why) = self.grip_check(piece) {
             self.record.grip_failed.push((piece.id.clone(), why));
             self.take_off(&piece.id);
@@ -531,7 +588,14 @@ impl<'a> WallRun<'a> {
 
         // Pick: approach above, descend, close the jaws, lift.
         let start = self.begin(id, "pick", &[]);
-        self.move_to(&plan.q_above_pick.clone(), &grip, &[id]);
+        // The approach must not touch the piece either; the descent and grip may.
+        if let Some(current) = &mut self.current {
+            current.2.clear();
+        }
+        self.move_to(&plan.q_above_pick.clone(), &grip, &[]);
+        if let Some(current) = &mut self.current {
+            current.2.push(format!("piece {id}"));
+        }
         let above_pick = raise(&plan.pick, CLEARANCE);
         let ok = self
             .run_line(
@@ -560,17 +624,34 @@ impl<'a> WallRun<'a> {
         self.start_belts(id);
         self.end(id, "pick", start);
 
+        // The place pose from how the piece actually sits in the gripper.
+        let (place, q_above_place) = match &self.held {
+            Some(h) => {
+                let place = plan.target * h.in_tool.inverse() * grip;
+                match solve(
+                    self.cell,
+                    &raise(&place, CLEARANCE),
+                    &grip,
+                    &plan.q_above_place,
+                ) {
+                    Ok(q) => (place, q),
+                    Err(_) => (plan.place, plan.q_above_place.clone()),
+                }
+            }
+            None => (plan.place, plan.q_above_place.clone()),
+        };
+
         // Move above the target.
         let start = self.begin(id, "move", &[]);
         if ok {
-            self.move_to(&plan.q_above_place.clone(), &grip, &[]);
+            self.move_to(&q_above_place, &grip, &[]);
         }
         self.end(id, "move", start);
 
         // Place: descend, open, release, retract.
         let start = self.begin(id, "place", &[]);
-        let above_place = raise(&plan.place, CLEARANCE);
-        let release = raise(&plan.place, RELEASE_GAP);
+        let above_place = raise(&place, CLEARANCE);
+        let release = raise(&place, RELEASE_GAP);
         let ok = ok
             && self
                 .run_line(
@@ -680,17 +761,19 @@ impl<'a> WallRun<'a> {
                     Ok((q_above_pick, q_pick, q_above_place, q_place)) => {
                         let held_in_tool = grip * in_body.inverse();
                         let half = piece.size.map(|v| v / 2.0);
-                        let clear = touches(
-                            &self.phys,
-                            self.cell,
-                            &q_place,
-                            Some((piece.id.as_str(), &held_in_tool, half)),
-                            &[],
-                        )
-                        .is_none();
+                        let held = Some((piece.id.as_str(), &held_in_tool, half));
+                        let blocked =
+                            touches(&self.phys, self.cell, &q_place, held, &[]).or_else(|| {
+                                touches(&self.phys, self.cell, &q_pick, None, &[&piece.id])
+                            });
+                        if let Some((a, b)) = blocked {
+                            // A reachable pose that collides: the closest kind of miss.
+                            note_miss("place", IkFailure::AllSolutionsCollide { pair: [a, b] });
+                            continue;
+                        }
                         let travel = distance(&self.q, &q_above_pick)
                             + distance(&q_above_pick, &q_above_place);
-                        let score = (1.0 - down) * 100.0 + if clear { 0.0 } else { 50.0 } + travel;
+                        let score = (1.0 - down) * 100.0 + travel;
                         if best.as_ref().is_none_or(|b| score < b.0) {
                             best = Some((
                                 score,
@@ -700,9 +783,7 @@ impl<'a> WallRun<'a> {
                                     pick,
                                     place,
                                     q_above_pick,
-                                    q_pick,
                                     q_above_place,
-                                    q_place,
                                     target,
                                 },
                             ));
@@ -740,43 +821,35 @@ impl<'a> WallRun<'a> {
             }
             let point = self.wall_cell * Point3::from(Vector3::from(nail.uvw));
             let direction = self.wall_cell.rotation * nail.direction;
-            let mut chosen: Option<(bool, Isometry3<f64>, Vec<f64>, Vec<f64>)> = None;
+            let mut chosen: Option<(Isometry3<f64>, Vec<f64>)> = None;
             let mut miss: Option<(f64, IkFailure)> = None;
             for roll in nail_rolls() {
                 let pose = nail_pose(&point, &direction, roll);
                 let back = retreat(&pose, NAIL_APPROACH);
                 let attempt = solve(self.cell, &back, &nail_tcp, &self.q).and_then(|qa| {
-                    Ok((
-                        qa.clone(),
-                        line(self.cell, &qa, &back, &pose, &nail_tcp, 4)?,
-                    ))
+                    let q_nail = line(self.cell, &qa, &back, &pose, &nail_tcp, 4)?;
+                    let ignore = [nail.plate.as_str(), nail.member.as_str()];
+                    match touches(&self.phys, self.cell, &q_nail, None, &ignore)
+                        .or_else(|| touches(&self.phys, self.cell, &qa, None, &ignore))
+                    {
+                        Some((a, b)) => Err(IkFailure::AllSolutionsCollide { pair: [a, b] }),
+                        None => Ok(qa),
+                    }
                 });
                 match attempt {
+                    Ok(q_back) => {
+                        chosen = Some((pose, q_back));
+                        break;
+                    }
                     Err(f) => {
                         let score = failure_score(&f);
                         if miss.as_ref().is_none_or(|m| score < m.0) {
                             miss = Some((score, f));
                         }
                     }
-                    Ok((q_back, q_nail)) => {
-                        let clear = touches(
-                            &self.phys,
-                            self.cell,
-                            &q_nail,
-                            None,
-                            &[nail.plate.as_str(), nail.member.as_str()],
-                        )
-                        .is_none();
-                        if chosen.as_ref().is_none_or(|c| !c.0 && clear) {
-                            chosen = Some((clear, pose, q_back, q_nail));
-                        }
-                        if clear {
-                            break;
-                        }
-                    }
                 }
             }
-            let Some((_, pose, q_back, _)) = chosen else {
+            let Some((pose, q_back)) = chosen else {
                 let failure = miss.map_or(IkFailure::InvalidPose, |m| m.1);
                 let (kind, what, value, limit) = failure_columns(&failure);
                 self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
@@ -1060,6 +1133,8 @@ fn failure_score(f: &IkFailure) -> f64 {
         } => (distance - reach).max(min_reach - distance).max(0.0),
         IkFailure::JointLimit { excess, .. } => excess.abs(),
         IkFailure::WristSingularity { margin, required } => (required - margin).max(0.0),
+        // Reachable but colliding: the most telling miss.
+        IkFailure::AllSolutionsCollide { .. } => -1.0,
         _ => 10.0,
     }
 }

@@ -39,7 +39,7 @@ impl Default for SimOptions {
     fn default() -> Self {
         SimOptions {
             walls: Vec::new(),
-            dt: 1.0 / 120.0,
+            dt: 1.0 / 240.0,
             speed: 1.0,
             engine: RuleEngine::Compiled,
         }

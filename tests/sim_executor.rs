@@ -1,0 +1,203 @@
+//! The executor on the bundled models: placement accuracy, the study's reach findings on its
+//! test model 3, a bad cell's collision, determinism.
+
+use framewright::cell::Cell;
+use framewright::ifc::Model;
+use framewright::report::simulate::SimReport;
+use framewright::sim::{SimOptions, Simulation, simulate};
+use std::path::Path;
+
+fn model(name: &str) -> Model {
+    Model::open(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/models")
+            .join(name),
+    )
+    .expect("bundled model")
+}
+
+fn run(model_name: &str, cell: &str, walls: &[&str]) -> (Simulation, SimReport) {
+    let options = SimOptions {
+        walls: walls.iter().map(|w| w.to_string()).collect(),
+        ..SimOptions::default()
+    };
+    let cell = Cell::load(cell).expect("cell");
+    let sim = simulate(&model(model_name), &cell, &options).expect("simulation runs");
+    let report = SimReport::new(&sim, options.dt);
+    (sim, report)
+}
+
+fn json(report: &SimReport) -> String {
+    let mut out = Vec::new();
+    report.write_json(&mut out).unwrap();
+    String::from_utf8(out).unwrap()
+}
+
+#[test]
+fn tm2_frames_every_piece_within_2_mm_and_1_degree() {
+    let (sim, report) = run("tm2.ifc", "study-abb", &[]);
+    assert_eq!(report.walls.len(), 1);
+    assert_eq!(
+        report.walls[0].framing.status,
+        "Completed",
+        "{}",
+        report.to_text()
+    );
+    assert_eq!(report.walls[0].material_feeding, "Completed");
+    let placements = &sim.records[0].placements;
+    assert_eq!(placements.len(), 4, "every piece placed");
+    for p in placements {
+        assert!(
+            p.position_error <= 0.002,
+            "{} off by {} m",
+            p.piece,
+            p.position_error
+        );
+        assert!(
+            p.angle_error <= 1f64.to_radians(),
+            "{} turned {} rad",
+            p.piece,
+            p.angle_error
+        );
+    }
+    // Every driven nail is checked against the as-built pieces.
+    let v = &report.nailing_validation;
+    assert_eq!(v.planned, 8);
+    let fired = v.targets.iter().filter(|t| t.status == "fired").count();
+    assert!(fired > 0);
+    assert_eq!(v.checked, fired);
+    assert!(
+        v.targets
+            .iter()
+            .filter(|t| t.status == "fired")
+            .all(|t| t.error_mm.is_some())
+    );
+    assert!(v.max_error_mm < 2.0, "max nail error {} mm", v.max_error_mm);
+    assert!(v.all_inside_members);
+    // Every skipped nail says why.
+    for e in &report.elements {
+        if e.nailing.status != "nailed" && e.nailing.status != "none" {
+            assert!(
+                !e.nailing.reasons.is_empty(),
+                "{} has no nailing reason",
+                e.id
+            );
+        }
+    }
+}
+
+#[test]
+fn tm3_long_wall_plates_and_end_studs_are_beyond_reach() {
+    // Wall 1 of the study's test model 3 (6.86 m long) on the ABB cell.
+    let (sim, report) = run("tm3.ifc", "study-abb", &["Wall 1"]);
+    let wall = &report.walls[0];
+    assert_eq!(wall.framing.status, "Partial", "{}", report.to_text());
+    assert!(wall.framing.failed_component.contains("Robot"));
+    let beyond = |id: &str| {
+        report
+            .elements
+            .iter()
+            .find(|e| e.id == id)
+            .is_some_and(|e| {
+                e.framing
+                    .reasons
+                    .iter()
+                    .any(|r| r.message.contains("beyond reach"))
+            })
+    };
+    let plan_wall = &sim.plan.walls[0];
+    for (id, role) in &sim.plan.roles {
+        if plan_wall.members.contains(id) && role.ends_with("plate") {
+            assert!(beyond(id), "{role} {id} should be beyond reach");
+        }
+    }
+    // The end studs: the first and last along the wall.
+    let studs: Vec<&String> = plan_wall
+        .framing_targets
+        .iter()
+        .map(|(id, _)| id)
+        .filter(|id| sim.plan.roles.get(*id).is_some_and(|r| r == "stud"))
+        .collect();
+    let along = |id: &String| {
+        let t = &plan_wall
+            .framing_targets
+            .iter()
+            .find(|(p, _)| p == id)
+            .unwrap()
+            .1;
+        t.translation.y
+    };
+    let first = studs
+        .iter()
+        .min_by(|a, b| along(a).total_cmp(&along(b)))
+        .unwrap();
+    let last = studs
+        .iter()
+        .max_by(|a, b| along(a).total_cmp(&along(b)))
+        .unwrap();
+    assert!(beyond(first) && beyond(last), "end studs beyond reach");
+    // The reason carries the numbers: distance and reach.
+    let reason = &report
+        .elements
+        .iter()
+        .find(|e| &e.id == *first)
+        .unwrap()
+        .framing
+        .reasons[0];
+    assert!(
+        reason
+            .message
+            .contains(" m from the shoulder, the arm reaches "),
+        "{}",
+        reason.message
+    );
+    // The verdict relation and the simulation fact behind it.
+    let failed = sim.reasoned.get("sim_ik_failed");
+    assert!(
+        failed
+            .iter()
+            .any(|t| t[0].as_symbol() == Some(first.as_str()))
+    );
+}
+
+#[test]
+fn a_tool_table_in_the_arm_s_path_is_reported_with_bodies_and_time() {
+    let cell =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/cells/bad-tool-table.toml");
+    let (_, report) = run("tm2.ifc", cell.to_str().unwrap(), &[]);
+    let hits: Vec<_> = report
+        .contacts
+        .iter()
+        .filter(|c| c.body_b.starts_with("tool table"))
+        .collect();
+    assert!(!hits.is_empty(), "{}", report.to_text());
+    assert!(hits.iter().all(|c| c.t > 0.0 && c.depth_mm > 1.0));
+    assert_ne!(report.walls[0].framing.status, "Completed");
+    assert!(report.walls[0].framing.failed_component.contains("Robot"));
+    let text = report.to_text();
+    assert!(text.contains("touched tool table"), "{text}");
+}
+
+#[test]
+fn two_runs_give_byte_identical_json() {
+    let (_, a) = run("tm1.ifc", "study-abb", &[]);
+    let (_, b) = run("tm1.ifc", "study-abb", &[]);
+    assert_eq!(json(&a), json(&b));
+}
+
+#[test]
+fn an_unknown_wall_is_an_error_naming_the_walls() {
+    let cell = Cell::load("study-abb").unwrap();
+    let options = SimOptions {
+        walls: vec!["nope".into()],
+        ..SimOptions::default()
+    };
+    let Err(e) = simulate(&model("tm1.ifc"), &cell, &options) else {
+        panic!("an unknown wall must be refused");
+    };
+    let message = e.to_string();
+    assert!(
+        message.contains("`nope`") && message.contains("Wall 1"),
+        "{message}"
+    );
+}
