@@ -161,6 +161,20 @@ fn rules_dir_replaces_the_builtin_rule_base() {
         .map(|f| f["id"].as_str().unwrap())
         .collect();
     assert_eq!(ids.len(), 2, "the two 6.858 m top plates: {ids:?}");
+    // A user file inside the directory would be read as part of the rule base too.
+    let inside = dir.path().join("mine.dl");
+    std::fs::copy(&user, &inside).unwrap();
+    let out = run(&[
+        "check",
+        s(&model),
+        "--rules",
+        s(&inside),
+        "--rules-dir",
+        s(dir.path()),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("lies in the rules directory"));
+    std::fs::remove_file(&inside).unwrap();
     // Without the directory the relation does not exist.
     let out = run(&["check", s(&model), "--rules", s(&user)]);
     assert_eq!(out.status.code(), Some(2));

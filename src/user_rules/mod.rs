@@ -50,6 +50,31 @@ pub enum UserRulesError {
     RulesDir { path: PathBuf, message: String },
     #[error("cannot read rule file {}: {message}; check the path", path.display())]
     RuleFile { path: PathBuf, message: String },
+    #[error("the user rule file {} lies in the rules directory {}, so it would also be read as part of the rule base; keep user rule files outside --rules-dir", file.display(), dir.display())]
+    InsideRulesDir { file: PathBuf, dir: PathBuf },
+}
+
+/// A user file inside the `--rules-dir` directory would be loaded twice.
+fn check_outside_rules_dir(files: &[PathBuf], base: &RuleEngine) -> Result<(), UserRulesError> {
+    let RuleEngine::Directory(dir) = base else {
+        return Ok(());
+    };
+    let Ok(dir_c) = dir.canonicalize() else {
+        return Ok(());
+    };
+    for f in files {
+        let parent = f
+            .canonicalize()
+            .ok()
+            .and_then(|c| c.parent().map(Path::to_path_buf));
+        if parent.as_deref() == Some(dir_c.as_path()) {
+            return Err(UserRulesError::InsideRulesDir {
+                file: f.clone(),
+                dir: dir.clone(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Every user file must be readable (checked up front for a plain message).
@@ -108,6 +133,7 @@ impl UserRules {
     /// (`RuleEngine::Directory`).
     pub fn load(files: &[PathBuf], base: &RuleEngine) -> Result<UserRules, UserRulesError> {
         check_readable(files)?;
+        check_outside_rules_dir(files, base)?;
         let base_program = base_program(base)?;
         refuse_redeclarations(files, &base_program)?;
         let sigs = functors::signatures();
@@ -230,6 +256,7 @@ pub fn base_program(base: &RuleEngine) -> Result<Program, UserRulesError> {
 /// (user files refused when they redefine a base relation).
 pub fn full_program(base: &RuleEngine, user_files: &[PathBuf]) -> Result<Program, UserRulesError> {
     check_readable(user_files)?;
+    check_outside_rules_dir(user_files, base)?;
     let base_prog = base_program(base)?;
     refuse_redeclarations(user_files, &base_prog)?;
     let sigs = functors::signatures();
