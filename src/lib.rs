@@ -14,4 +14,5 @@ pub mod report;
 pub mod sim;
 pub mod step;
 pub mod synth;
+pub mod user_rules;
 pub mod world;

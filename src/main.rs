@@ -35,6 +35,12 @@ enum Command {
     World(cli::world::WorldArgs),
     /// Simulate the framing and nailing of every wall and print the verdicts.
     Simulate(cli::simulate::SimulateArgs),
+    /// Run user shop rules (violation/warning) over the model's relations.
+    Check(cli::check::CheckArgs),
+    /// Explain an element's verdicts down to IFC entities, cell keys and rules.
+    Why(cli::why::WhyArgs),
+    /// Say which rule could derive a tuple and which condition failed.
+    WhyNot(cli::why::WhyNotArgs),
 }
 
 fn main() -> ExitCode {
@@ -47,6 +53,9 @@ fn main() -> ExitCode {
         Command::Synth(args) => cli::synth::run(args),
         Command::World(args) => cli::world::run(args),
         Command::Simulate(args) => cli::simulate::run(args),
+        Command::Check(args) => cli::check::run(args),
+        Command::Why(args) => cli::why::run_why(args),
+        Command::WhyNot(args) => cli::why::run_why_not(args),
     };
     match result {
         Ok(code) => code,

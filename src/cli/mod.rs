@@ -1,12 +1,14 @@
 //! Subcommands. Every `run` returns `CmdResult`; a `Failure` carries the
 //! message shown to the user and the exit code (2 = bad input).
 
+pub mod check;
 pub mod inspect;
 pub mod plan;
 pub mod robot;
 pub mod rules;
 pub mod simulate;
 pub mod synth;
+pub mod why;
 pub mod world;
 
 use std::io::Write;

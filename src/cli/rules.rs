@@ -28,10 +28,18 @@ pub enum RulesCommand {
     },
     /// Check a rule program without running it.
     Check { program: PathBuf },
+    /// Print the reference of the built-in relations (docs/RELATIONS.md) as Markdown.
+    Relations,
 }
 
 pub fn run(cmd: RulesCommand) -> CmdResult {
     match cmd {
+        RulesCommand::Relations => {
+            let base = Program::builtin()?;
+            print_stdout(&framewright::user_rules::relations_doc::relations_markdown(
+                &base,
+            ))
+        }
         RulesCommand::Check { program } => {
             let p = Program::parse_files(&[&program])?;
             print_stdout(&format!(

@@ -1,0 +1,202 @@
+//! `framewright check MODEL.ifc --rules FILE.dl [--rules …] [--cell C] [--json]`:
+//! user shop rules over the relations of the rule base. Exit code 1 when a
+//! rule found a violation, 2 for bad input (model, cell, rule files).
+
+use super::{CmdResult, Failure, print_stdout};
+use framewright::cell::Cell;
+use framewright::frame::cell_facts::cell_facts;
+use framewright::frame::{Facts, RuleEngine, model_facts, reason};
+use framewright::geom::ContactOptions;
+use framewright::ifc::Model;
+use framewright::sim::{SimOptions, simulate};
+use framewright::user_rules::{Finding, Findings, UserRules};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(clap::Args)]
+pub struct CheckArgs {
+    /// The IFC model.
+    pub model: PathBuf,
+    /// A user rule file deriving violation(id, rule, message) or warning(...). Repeatable.
+    #[arg(long = "rules", value_name = "FILE.dl", required = true)]
+    pub rules: Vec<PathBuf>,
+    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    #[arg(long, default_value = "study-abb")]
+    pub cell: String,
+    /// Print JSON instead of one line per finding.
+    #[arg(long)]
+    pub json: bool,
+    /// Replace the built-in rule base with every .dl file of this directory.
+    #[arg(long, value_name = "DIR")]
+    pub rules_dir: Option<PathBuf>,
+    /// Largest gap between two pieces still taken as touching, millimetres.
+    #[arg(long, value_name = "MM", default_value_t = 3.0)]
+    pub contact_tolerance: f64,
+    /// Simulate the walls first, so rules can read the executor's facts (sim_*) and verdicts.
+    #[arg(long)]
+    pub simulate: bool,
+    /// With --simulate: only this wall (id or name); repeat for more.
+    #[arg(long = "wall", value_name = "W", requires = "simulate")]
+    pub walls: Vec<String>,
+}
+
+/// The model, the cell and their facts (what plan, check and why start from).
+pub fn load_inputs(
+    model: &Path,
+    cell: &str,
+    contact_tolerance_mm: f64,
+) -> Result<(Model, Cell, Facts), Failure> {
+    if !(contact_tolerance_mm.is_finite() && (0.0..=100.0).contains(&contact_tolerance_mm)) {
+        return Err(Failure::bad_input(format!(
+            "--contact-tolerance {contact_tolerance_mm} mm is out of range; give 0 to 100 mm"
+        )));
+    }
+    let model = Model::open(model)?;
+    let cell = Cell::load(cell)?;
+    let contacts = ContactOptions {
+        tolerance: contact_tolerance_mm / 1000.0,
+        ..ContactOptions::default()
+    };
+    let mut facts = model_facts(&model, &contacts);
+    facts.extend(cell_facts(&cell));
+    Ok((model, cell, facts))
+}
+
+pub fn rule_base(rules_dir: &Option<PathBuf>) -> RuleEngine {
+    rules_dir
+        .clone()
+        .map_or(RuleEngine::Compiled, RuleEngine::Directory)
+}
+
+#[derive(Serialize)]
+struct Report<'a> {
+    model: String,
+    cell: &'a str,
+    rule_files: Vec<String>,
+    violations: Vec<Row<'a>>,
+    warnings: Vec<Row<'a>>,
+}
+
+#[derive(Serialize)]
+struct Row<'a> {
+    id: &'a str,
+    /// IFC entity of the piece the id names (absent for other subjects).
+    entity: Option<u64>,
+    name: Option<&'a str>,
+    rule: &'a str,
+    message: &'a str,
+}
+
+pub fn run(args: CheckArgs) -> CmdResult {
+    let base = rule_base(&args.rules_dir);
+    // Rule files first: a typo fails before the model is read.
+    let user = UserRules::load(&args.rules, &base)?;
+    if args.simulate {
+        if args.contact_tolerance != 3.0 {
+            return Err(Failure::bad_input(
+                "--contact-tolerance cannot be combined with --simulate (the executor plans with the default tolerance)",
+            ));
+        }
+        // The executor reads the model and reasons itself.
+        let model = Model::open(&args.model)?;
+        let cell = Cell::load(&args.cell)?;
+        let options = SimOptions {
+            walls: args.walls.clone(),
+            engine: base.clone(),
+            ..SimOptions::default()
+        };
+        let sim = simulate(&model, &cell, &options)?;
+        let findings = user.evaluate(&sim.reasoned.relations)?;
+        return report(&args, &model, &cell.name, &findings);
+    }
+    let (model, cell, facts) = load_inputs(&args.model, &args.cell, args.contact_tolerance)?;
+    let reasoned = reason(&facts, &base, false)?;
+    let findings = user.evaluate(&reasoned.relations)?;
+    report(&args, &model, &cell.name, &findings)
+}
+
+fn report<'a>(
+    args: &'a CheckArgs,
+    model: &'a Model,
+    cell: &'a str,
+    findings: &'a Findings,
+) -> CmdResult {
+    let pieces: BTreeMap<&str, (u64, Option<&str>)> = model
+        .pieces()
+        .iter()
+        .map(|p| (p.id.as_str(), (p.entity, p.name.as_deref())))
+        .collect();
+    let rows = |list: &'a [Finding]| -> Vec<Row<'a>> {
+        list.iter()
+            .map(|f| {
+                let piece = pieces.get(f.id.as_str());
+                Row {
+                    id: &f.id,
+                    entity: piece.map(|p| p.0),
+                    name: piece.and_then(|p| p.1),
+                    rule: &f.rule,
+                    message: &f.message,
+                }
+            })
+            .collect()
+    };
+    let report = Report {
+        model: args.model.display().to_string(),
+        cell,
+        rule_files: args.rules.iter().map(|p| p.display().to_string()).collect(),
+        violations: rows(&findings.violations),
+        warnings: rows(&findings.warnings),
+    };
+    let text = if args.json {
+        let mut s = serde_json::to_string_pretty(&report)
+            .map_err(|e| Failure::bad_input(format!("cannot write JSON: {e}")))?;
+        s.push('\n');
+        s
+    } else {
+        to_text(&report, findings)
+    };
+    print_stdout(&text)?;
+    Ok(if findings.violations.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn to_text(report: &Report<'_>, findings: &Findings) -> String {
+    let mut s = String::new();
+    let width = report
+        .violations
+        .iter()
+        .chain(&report.warnings)
+        .map(|r| r.rule.len())
+        .max()
+        .unwrap_or(0);
+    for (kind, rows) in [
+        ("violation", &report.violations),
+        ("warning", &report.warnings),
+    ] {
+        for r in rows {
+            let who = match (r.entity, r.name) {
+                (Some(e), Some(n)) => format!("{} (#{e} '{n}')", r.id),
+                (Some(e), None) => format!("{} (#{e})", r.id),
+                _ => r.id.to_string(),
+            };
+            s.push_str(&format!(
+                "{kind:<9}  {:<width$}  {who}: {}\n",
+                r.rule, r.message
+            ));
+        }
+    }
+    let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
+    s.push_str(&format!(
+        "{}, {} from {} ({})\n",
+        plural(findings.violations.len(), "violation"),
+        plural(findings.warnings.len(), "warning"),
+        plural(report.rule_files.len(), "rule file"),
+        report.rule_files.join(", ")
+    ));
+    s
+}

@@ -1,0 +1,230 @@
+//! `framewright why MODEL.ifc ID` and `framewright why-not MODEL.ifc 'rel(…)'`:
+//! an element's verdicts with their derivations down to IFC entities, cell
+//! keys and rule lines; or which rule could have derived a tuple and which
+//! condition failed.
+
+use super::check::{load_inputs, rule_base};
+use super::{CmdResult, Failure, print_stdout};
+use framewright::user_rules::render::{render_why, render_why_not};
+use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
+use framewright::user_rules::why::{Context, WhyError, element_walls, why, why_not};
+use serde::Serialize;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct WhyArgs {
+    /// The IFC model.
+    pub model: PathBuf,
+    /// A piece id, an IFC GlobalId or an entity `#id`.
+    pub id: String,
+    #[command(flatten)]
+    pub common: Common,
+}
+
+#[derive(clap::Args)]
+pub struct WhyNotArgs {
+    /// The IFC model.
+    pub model: PathBuf,
+    /// The tuple, e.g. 'role(#47, king_stud)' (`#id` stands for the piece of that entity).
+    pub tuple: String,
+    #[command(flatten)]
+    pub common: Common,
+}
+
+#[derive(clap::Args)]
+pub struct Common {
+    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    #[arg(long, default_value = "study-abb")]
+    pub cell: String,
+    /// Print the complete trees as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// User rule files whose findings are explained too. Repeatable.
+    #[arg(long = "rules", value_name = "FILE.dl")]
+    pub rules: Vec<PathBuf>,
+    /// Replace the built-in rule base with every .dl file of this directory.
+    #[arg(long, value_name = "DIR")]
+    pub rules_dir: Option<PathBuf>,
+    /// Largest gap between two pieces still taken as touching, millimetres.
+    #[arg(long, value_name = "MM", default_value_t = 3.0)]
+    pub contact_tolerance: f64,
+    /// Explain the plan only: do not simulate the element's wall.
+    #[arg(long)]
+    pub no_simulate: bool,
+    /// Where simulated walls are cached (default: $FRAMEWRIGHT_CACHE, $XDG_CACHE_HOME/framewright or ~/.cache/framewright).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+}
+
+/// A wall simulated for the explanation.
+#[derive(Serialize)]
+struct Simulated {
+    wall: String,
+    from_cache: bool,
+}
+
+/// Adds the executor's facts of the walls of the pieces in `ids` (each wall
+/// simulated once, then cached), unless `--no-simulate`.
+fn simulate_walls(
+    c: &Common,
+    model_path: &std::path::Path,
+    model: &framewright::ifc::Model,
+    cell: &framewright::cell::Cell,
+    facts: &mut framewright::frame::Facts,
+    ids: &[String],
+) -> Result<Vec<Simulated>, Failure> {
+    if c.no_simulate {
+        return Ok(Vec::new());
+    }
+    let base = rule_base(&c.rules_dir);
+    let ctx = Context {
+        model,
+        facts,
+        base: &base,
+        user_files: &c.rules,
+    };
+    let mut walls = Vec::new();
+    for id in ids {
+        for w in element_walls(&ctx, id).map_err(failure)? {
+            if !walls.contains(&w) {
+                walls.push(w);
+            }
+        }
+    }
+    let cache = c.cache_dir.clone().or_else(default_cache_dir);
+    let mut out = Vec::new();
+    for wall in walls {
+        let (sim, cached) =
+            wall_sim_facts(model_path, model, cell, &wall, &base, cache.as_deref())?;
+        facts.extend(sim);
+        out.push(Simulated {
+            wall,
+            from_cache: cached,
+        });
+    }
+    Ok(out)
+}
+
+#[derive(Serialize)]
+struct Envelope<'a, T: Serialize> {
+    model: String,
+    cell: &'a str,
+    query: &'a str,
+    #[serde(flatten)]
+    answer: T,
+}
+
+fn json<T: Serialize>(value: &T) -> Result<String, Failure> {
+    let mut s = serde_json::to_string_pretty(value)
+        .map_err(|e| Failure::bad_input(format!("cannot write JSON: {e}")))?;
+    s.push('\n');
+    Ok(s)
+}
+
+fn failure(e: WhyError) -> Failure {
+    Failure::from(e)
+}
+
+pub fn run_why(args: WhyArgs) -> CmdResult {
+    let c = &args.common;
+    let base = rule_base(&c.rules_dir);
+    let (model, cell, mut facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let simulated = simulate_walls(
+        c,
+        &args.model,
+        &model,
+        &cell,
+        &mut facts,
+        std::slice::from_ref(&args.id),
+    )?;
+    let ctx = Context {
+        model: &model,
+        facts: &facts,
+        base: &base,
+        user_files: &c.rules,
+    };
+    let reports = why(&ctx, &args.id).map_err(failure)?;
+    let text = if c.json {
+        #[derive(Serialize)]
+        struct Elements<'a, T> {
+            simulated: &'a [Simulated],
+            elements: T,
+        }
+        json(&Envelope {
+            model: args.model.display().to_string(),
+            cell: &cell.name,
+            query: &args.id,
+            answer: Elements {
+                simulated: &simulated,
+                elements: &reports,
+            },
+        })?
+    } else {
+        let mut text = String::new();
+        for s in &simulated {
+            text.push_str(&format!(
+                "simulated wall {}{}\n",
+                s.wall,
+                if s.from_cache {
+                    " (from the cache)"
+                } else {
+                    ""
+                }
+            ));
+        }
+        if c.no_simulate {
+            text.push_str("not simulated (--no-simulate): plan verdicts only\n");
+        }
+        text.push_str(&render_why(&reports));
+        text
+    };
+    print_stdout(&text)
+}
+
+pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
+    let c = &args.common;
+    let base = rule_base(&c.rules_dir);
+    let (model, cell, mut facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let ids = piece_ids_in(&model, &args.tuple);
+    simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
+    let ctx = Context {
+        model: &model,
+        facts: &facts,
+        base: &base,
+        user_files: &c.rules,
+    };
+    let report = why_not(&ctx, &args.tuple).map_err(failure)?;
+    let text = if c.json {
+        json(&Envelope {
+            model: args.model.display().to_string(),
+            cell: &cell.name,
+            query: &args.tuple,
+            answer: &report,
+        })?
+    } else {
+        render_why_not(&args.tuple, &report)
+    };
+    print_stdout(&text)
+}
+
+/// The pieces a why-not tuple names (`#entity` or a piece id), as IDs for `why`.
+fn piece_ids_in(model: &framewright::ifc::Model, tuple: &str) -> Vec<String> {
+    let inner = tuple
+        .split_once('(')
+        .map_or("", |(_, r)| r)
+        .trim_end_matches(')');
+    let mut ids = Vec::new();
+    for arg in inner.split(',') {
+        let arg = arg.trim().trim_matches('"');
+        let known = if let Some(n) = arg.strip_prefix('#') {
+            n.parse::<u64>()
+                .is_ok_and(|n| model.pieces().iter().any(|p| p.entity == n || p.item == n))
+        } else {
+            model.pieces().iter().any(|p| p.id == arg)
+        };
+        if known && !ids.iter().any(|i| i == arg) {
+            ids.push(arg.to_string());
+        }
+    }
+    ids
+}

@@ -1,0 +1,412 @@
+//! Text form of `why` and `why-not` for a terminal: a tree per verdict with
+//! the widest supporting facts first (the premise resting on the most facts),
+//! numbers shortened, a fact already shown printed once, and long runs of
+//! input facts of one relation folded with a count. `--json` has everything.
+
+use super::why::{Verdict, WhyNotNode, WhyNotReport, WhyReport};
+use crate::logic::provenance::{Explanation, How, Premise};
+use crate::logic::{Origin, Value};
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+
+/// Input facts of one relation shown under a node before the rest are folded.
+const FOLD_AFTER: usize = 3;
+/// Levels of a tree shown on a terminal; deeper facts are counted.
+const MAX_DEPTH: usize = 6;
+/// Conditions longer than this (aggregates over boxes) are cut.
+const MAX_CONDITION: usize = 160;
+
+pub fn render_why(reports: &[WhyReport]) -> String {
+    let mut s = String::new();
+    for (k, r) in reports.iter().enumerate() {
+        if k > 0 {
+            s.push('\n');
+        }
+        let e = &r.element;
+        let name = e.name.as_deref().unwrap_or("");
+        let _ = writeln!(
+            s,
+            "{} '{name}' ({} #{}, GlobalId {}){}",
+            e.id,
+            e.ifc_type,
+            e.entity,
+            e.global_id,
+            r.wall
+                .as_ref()
+                .map_or(String::from(", in no wall"), |w| format!(", wall {w}"))
+        );
+        if r.verdicts.is_empty() {
+            s.push_str("  no verdicts: the rules derived nothing about this piece\n");
+        }
+        for v in &r.verdicts {
+            s.push('\n');
+            render_verdict(&mut s, v);
+        }
+    }
+    s
+}
+
+fn render_verdict(s: &mut String, v: &Verdict) {
+    // Each verdict's tree stands on its own: a fact repeats across verdicts.
+    let mut shown = BTreeSet::new();
+    render_node(s, &v.explanation, "", "", 0, &mut shown);
+    let src = &v.sources;
+    let entities: Vec<String> = src.ifc_entities.iter().map(|n| format!("#{n}")).collect();
+    let _ = writeln!(
+        s,
+        "  = {} facts, {} rules; IFC {}; cell keys: {}{}{}",
+        src.facts,
+        src.rules.len(),
+        if entities.is_empty() {
+            "none".to_string()
+        } else {
+            entities.join(" ")
+        },
+        if src.cell_keys.is_empty() {
+            "none".to_string()
+        } else {
+            src.cell_keys.join(", ")
+        },
+        if src.simulation_facts > 0 {
+            format!("; {} simulation facts", src.simulation_facts)
+        } else {
+            String::new()
+        },
+        if src.truncated {
+            "; tree cut (see --json)"
+        } else {
+            ""
+        }
+    );
+}
+
+fn fact(e: &Explanation) -> String {
+    let args: Vec<String> = e.tuple.iter().map(short_value).collect();
+    format!("{}({})", e.relation, args.join(", "))
+}
+
+/// Number of nodes under (and including) `e`.
+fn size(e: &Explanation) -> usize {
+    match &e.how {
+        How::Rule { premises, .. } => {
+            1 + premises
+                .iter()
+                .map(|p| match p {
+                    Premise::Tuple(t) => size(t),
+                    _ => 0,
+                })
+                .sum::<usize>()
+        }
+        _ => 1,
+    }
+}
+
+fn origin_text(relation: &str, tuple: &[Value], origin: &Origin) -> String {
+    match origin {
+        Origin::Entity(n) => format!("IFC #{n}"),
+        Origin::File { file, line: 0 } if relation.starts_with("cell_") => {
+            let key = tuple.first().and_then(Value::as_symbol).unwrap_or("");
+            format!("cell {file}, key {key}")
+        }
+        Origin::File { file, line } => format!("{file}:{line}"),
+        Origin::Event(e) => format!("simulation: {e}"),
+        Origin::Rust => "input".to_string(),
+    }
+}
+
+fn render_node(
+    s: &mut String,
+    e: &Explanation,
+    first: &str,
+    rest: &str,
+    depth: usize,
+    shown: &mut BTreeSet<String>,
+) {
+    let head = fact(e);
+    match &e.how {
+        How::Input { origin } => {
+            let _ = writeln!(
+                s,
+                "{first}{head}  [{}]",
+                origin_text(&e.relation, &e.tuple, origin)
+            );
+        }
+        How::Truncated => {
+            let _ = writeln!(s, "{first}{head}  [… cut, see --json]");
+        }
+        How::Rule { rule, premises, .. } => {
+            if !shown.insert(head.clone()) {
+                let _ = writeln!(s, "{first}{head}  [by {rule}, shown above]");
+                return;
+            }
+            let _ = writeln!(s, "{first}{head}  [by {rule}]");
+            if depth + 1 >= MAX_DEPTH && !premises.is_empty() {
+                let below = size(e) - 1;
+                let _ = writeln!(
+                    s,
+                    "{rest}└─ … {below} more fact{} below (--json has the whole tree)",
+                    if below == 1 { "" } else { "s" }
+                );
+                return;
+            }
+            let lines = children(premises);
+            for (i, line) in lines.iter().enumerate() {
+                let last = i + 1 == lines.len();
+                let (f, r) = if last {
+                    ("└─ ", "   ")
+                } else {
+                    ("├─ ", "│  ")
+                };
+                let f = format!("{rest}{f}");
+                let r = format!("{rest}{r}");
+                match line {
+                    Child::Node(t) => render_node(s, t, &f, &r, depth + 1, shown),
+                    Child::Text(t) => {
+                        let _ = writeln!(s, "{f}{t}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+enum Child<'a> {
+    Node(&'a Explanation),
+    Text(String),
+}
+
+/// Premises ordered widest first (most supporting facts; ties in rule
+/// order), then the conditions; input facts of a relation beyond
+/// `FOLD_AFTER` folded into one line.
+fn children(premises: &[Premise]) -> Vec<Child<'_>> {
+    let mut tuples: Vec<&Explanation> = premises
+        .iter()
+        .filter_map(|p| match p {
+            Premise::Tuple(t) => Some(&**t),
+            _ => None,
+        })
+        .collect();
+    tuples.sort_by_key(|t| std::cmp::Reverse(size(t)));
+    let mut out = Vec::new();
+    let mut inputs_shown: Vec<(&str, usize)> = Vec::new();
+    let mut folded: Vec<(&str, usize)> = Vec::new();
+    for t in tuples {
+        if matches!(t.how, How::Input { .. }) {
+            let n = match inputs_shown.iter_mut().find(|(r, _)| *r == t.relation) {
+                Some((_, n)) => {
+                    *n += 1;
+                    *n
+                }
+                None => {
+                    inputs_shown.push((&t.relation, 1));
+                    1
+                }
+            };
+            if n > FOLD_AFTER {
+                match folded.iter_mut().find(|(r, _)| *r == t.relation) {
+                    Some((_, k)) => *k += 1,
+                    None => folded.push((&t.relation, 1)),
+                }
+                continue;
+            }
+        }
+        out.push(Child::Node(t));
+    }
+    for (rel, k) in folded {
+        out.push(Child::Text(format!("… and {k} more {rel} facts")));
+    }
+    for p in premises {
+        match p {
+            Premise::Absent { atom } => out.push(Child::Text(format!(
+                "{}  [no such fact]",
+                cut(&shorten_numbers(atom))
+            ))),
+            Premise::Condition { text } => out.push(Child::Text(format!(
+                "{}  [holds]",
+                cut(&shorten_numbers(text))
+            ))),
+            Premise::Tuple(_) => {}
+        }
+    }
+    out
+}
+
+fn cut(text: &str) -> String {
+    match text.char_indices().nth(MAX_CONDITION) {
+        Some((i, _)) => format!("{} …", &text[..i]),
+        None => text.to_string(),
+    }
+}
+
+pub fn render_why_not(query: &str, report: &WhyNotReport) -> String {
+    let mut s = String::new();
+    match report {
+        WhyNotReport::Holds { explanation } => {
+            let _ = writeln!(s, "{query} holds:");
+            let mut shown = BTreeSet::new();
+            render_node(&mut s, explanation, "", "", 0, &mut shown);
+        }
+        WhyNotReport::NotDerived { tree } => render_why_not_node(&mut s, tree, ""),
+    }
+    s
+}
+
+fn render_why_not_node(s: &mut String, node: &WhyNotNode, indent: &str) {
+    use crate::logic::provenance::Failure;
+    let w = &node.why_not;
+    let args: Vec<String> = w.tuple.iter().map(short_value).collect();
+    let _ = writeln!(
+        s,
+        "{indent}{}({}) is not derived.",
+        w.relation,
+        args.join(", ")
+    );
+    if let Some(r) = &w.reason {
+        let _ = writeln!(s, "{indent}  {r}");
+    }
+    let mut head_misfits = 0;
+    for a in &w.rules {
+        let text = match &a.failure {
+            Failure::Head { .. } => {
+                head_misfits += 1;
+                continue;
+            }
+            Failure::NoMatch {
+                atom,
+                candidates,
+                relation_size,
+            } => {
+                let mut t = format!(
+                    "no {} fact matches {}",
+                    relation_of(atom),
+                    shorten_numbers(atom)
+                );
+                if candidates.is_empty() {
+                    t.push_str(" (the relation is empty)");
+                } else {
+                    let _ = write!(t, "; closest of {relation_size}:");
+                    for c in candidates {
+                        let vals: Vec<String> = c.iter().map(short_value).collect();
+                        let _ = write!(t, "\n{indent}      ({})", vals.join(", "));
+                    }
+                }
+                t
+            }
+            Failure::NegationHolds { atom, existing } => {
+                let vals: Vec<String> = existing.iter().map(short_value).collect();
+                format!(
+                    "{} fails: the fact exists ({})",
+                    shorten_numbers(atom),
+                    vals.join(", ")
+                )
+            }
+            Failure::ConditionFalse { condition, example } => format!(
+                "condition `{condition}` is false, e.g. {}",
+                cut(&shorten_numbers(example))
+            ),
+            Failure::Derivable => {
+                "every condition holds: the tuple is derivable (the rules have not run?)".into()
+            }
+        };
+        let _ = writeln!(s, "{indent}- {}: {}", a.rule, a.rule_text);
+        let _ = writeln!(s, "{indent}    {text}");
+    }
+    if head_misfits > 0 {
+        let _ = writeln!(
+            s,
+            "{indent}- and {head_misfits} rule{} whose head cannot give this tuple",
+            if head_misfits == 1 { "" } else { "s" }
+        );
+    }
+    let deeper = format!("{indent}    ");
+    for b in &node.because {
+        let _ = writeln!(s, "{indent}  because:");
+        render_why_not_node(s, b, &deeper);
+    }
+}
+
+/// `rel` of an atom written `rel(...)` or `!rel(...)`.
+fn relation_of(atom: &str) -> &str {
+    let a = atom.trim_start_matches('!');
+    a.split('(').next().unwrap_or(a)
+}
+
+/// A value as a person reads it: numbers to 0.1 mm / 6 digits.
+pub fn short_value(v: &Value) -> String {
+    match v {
+        Value::Symbol(s) => format!("{:?}", &**s),
+        Value::Float(x) => short_float(x.0),
+        Value::Vec3(_) | Value::Iso(_) | Value::Box(_) => shorten_numbers(&v.to_string()),
+        other => other.to_string(),
+    }
+}
+
+fn short_float(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (6 - x.abs().log10().floor() as i32).clamp(0, 9) as usize;
+    let t = format!("{x:.digits$}");
+    let t = if t.contains('.') {
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        t
+    };
+    if t == "-0" { "0".into() } else { t }
+}
+
+/// Floats with more than 7 significant digits, outside quotes, shortened.
+pub fn shorten_numbers(text: &str) -> String {
+    let mut out = String::new();
+    let chars: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    let mut in_str = false;
+    while i < chars.len() {
+        let c = chars[i];
+        if c == '"' && (i == 0 || chars[i - 1] != '\\') {
+            in_str = !in_str;
+        }
+        let starts_number = !in_str
+            && (c.is_ascii_digit()
+                || (c == '-' && chars.get(i + 1).is_some_and(char::is_ascii_digit)))
+            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_'));
+        if starts_number {
+            let mut j = i + 1;
+            while j < chars.len()
+                && (chars[j].is_ascii_digit()
+                    || chars[j] == '.'
+                    || chars[j] == 'e'
+                    || ((chars[j] == '-' || chars[j] == '+') && chars[j - 1] == 'e'))
+            {
+                j += 1;
+            }
+            let word: String = chars[i..j].iter().collect();
+            match word.parse::<f64>() {
+                Ok(x) if word.contains('.') || word.contains('e') => out.push_str(&short_float(x)),
+                _ => out.push_str(&word),
+            }
+            i = j;
+            continue;
+        }
+        out.push(c);
+        i += 1;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_shortened_outside_quotes() {
+        assert_eq!(
+            shorten_numbers("x(0.10000000000000001, \"1.23456789\")"),
+            "x(0.1, \"1.23456789\")"
+        );
+        assert_eq!(shorten_numbers("a < 2.3526750000000002"), "a < 2.352675");
+        assert_eq!(shorten_numbers("p_2(-1e-17, 12)"), "p_2(0, 12)");
+        assert_eq!(short_float(1234.56789), "1234.568");
+        assert_eq!(short_float(-0.0000001), "-0.0000001");
+    }
+}

@@ -1,0 +1,324 @@
+//! `framewright why` and `why-not` on the command line: JSON structure, key
+//! text lines, byte-identical output run to run, and bad ids / tuples (exit 2).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn tm3() -> PathBuf {
+    root().join("examples/models/tm3.ifc")
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn bad(args: &[&str]) -> String {
+    let out = run(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    assert!(out.stdout.is_empty());
+    String::from_utf8(out.stderr).unwrap()
+}
+
+#[test]
+fn why_json_has_the_element_its_verdicts_and_complete_trees() {
+    let m = tm3();
+    let m = m.to_str().unwrap();
+    let text = ok(&["why", m, "#174", "--json", "--no-simulate"]);
+    assert_eq!(
+        text,
+        ok(&["why", m, "#174", "--json", "--no-simulate"]),
+        "deterministic"
+    );
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["cell"], "study-abb");
+    assert_eq!(v["query"], "#174");
+    let el = &v["elements"][0];
+    assert_eq!(el["element"]["entity"], 174);
+    assert_eq!(el["element"]["ifc_type"], "IfcBeam");
+    let verdicts = el["verdicts"].as_array().unwrap();
+    let role = verdicts.iter().find(|x| x["relation"] == "role").unwrap();
+    assert_eq!(role["tuple"][1], "top_plate");
+    assert_eq!(role["explanation"]["how"]["kind"], "rule");
+    assert!(
+        role["explanation"]["how"]["rule"]
+            .as_str()
+            .unwrap()
+            .starts_with("role_fitted (rules/roles.dl:")
+    );
+    // The JSON tree is complete: every leaf is an input with its origin, no cuts.
+    fn leaves(n: &serde_json::Value, inputs: &mut usize) {
+        match n["how"]["kind"].as_str().unwrap() {
+            "input" => *inputs += 1,
+            "rule" => {
+                for p in n["how"]["premises"].as_array().unwrap() {
+                    if p["kind"] == "tuple" {
+                        leaves(p, inputs);
+                    }
+                }
+            }
+            other => panic!("cut tree: {other}"),
+        }
+    }
+    let target = verdicts
+        .iter()
+        .find(|x| x["relation"] == "framing_target")
+        .unwrap();
+    let mut inputs = 0;
+    leaves(&target["explanation"], &mut inputs);
+    assert!(inputs > 20, "{inputs}");
+    assert_eq!(target["sources"]["truncated"], false);
+    assert!(
+        target["sources"]["ifc_entities"]
+            .as_array()
+            .unwrap()
+            .contains(&serde_json::json!(171))
+    );
+    let keys = target["sources"]["cell_keys"].as_array().unwrap();
+    assert!(keys.contains(&serde_json::json!("assembly_offset_x")));
+}
+
+#[test]
+fn why_text_names_the_element_rules_and_sources() {
+    let m = tm3();
+    let text = ok(&[
+        "why",
+        m.to_str().unwrap(),
+        "32H5oapRpM57uELNCcVku8",
+        "--no-simulate",
+    ]);
+    assert_eq!(
+        text.lines().next().unwrap(),
+        "not simulated (--no-simulate): plan verdicts only"
+    );
+    assert!(
+        text.lines()
+            .nth(1)
+            .unwrap()
+            .contains("'2x4 top plate F-020' (IfcBeam #174")
+    );
+    assert!(text.contains(
+        "\nrole(\"32H5oapRpM57uELNCcVku8\", \"top_plate\")  [by role_fitted (rules/roles.dl:"
+    ));
+    assert!(text.contains("└─ fitted_role(\"32H5oapRpM57uELNCcVku8\", \"top_plate\")  [by role_top_plate (rules/roles.dl:"));
+    assert!(text.contains("framing_target(\"32H5oapRpM57uELNCcVku8\", [2.940825,0,0.04445,0.5,0.5,-0.5,-0.5])  [by framing_target (rules/targets.dl:"));
+    assert!(text.contains("cell_value(\"assembly_offset_x\", 0.531)  [cell "));
+    assert!(text.contains("[IFC #171]"));
+    assert!(text.contains("  = "), "summary lines");
+}
+
+#[test]
+fn why_explains_user_findings() {
+    let model = root().join("tests/fixtures/synth_wall_door_window_in.ifc");
+    let rules = root().join("examples/rules/gripper_spacing.dl");
+    let text = ok(&[
+        "why",
+        model.to_str().unwrap(),
+        "#213",
+        "--rules",
+        rules.to_str().unwrap(),
+        "--no-simulate",
+    ]);
+    let first = text.lines().nth(3).unwrap();
+    assert!(first.starts_with("violation(\"1SLgxFv2F86AyYIFLQqMY1\", \"shorter_than_gripper_spacing\", \"member is 60 mm long, shorter than the gripper spacing (600 mm): both grippers cannot hold it\")  [by shorter_than_gripper_spacing ("), "{first}");
+    assert!(
+        first.contains("examples/rules/gripper_spacing.dl:5)]"),
+        "{first}"
+    );
+    assert!(
+        text.contains("cell_value(\"gripper_spacing\", 0.6)  [cell "),
+        "{text}"
+    );
+    assert!(
+        text.contains("piece_size(\"1SLgxFv2F86AyYIFLQqMY1\", 0.06"),
+        "{text}"
+    );
+}
+
+#[test]
+fn why_not_says_which_rule_and_condition_failed() {
+    let m = tm3();
+    let m = m.to_str().unwrap();
+    let text = ok(&["why-not", m, "role(#174, king_stud)", "--no-simulate"]);
+    assert!(text.starts_with("role(\"32H5oapRpM57uELNCcVku8\", \"king_stud\") is not derived.\n- role_fitted (rules/roles.dl:"), "{text}");
+    assert!(text.contains("no fitted_role fact matches fitted_role(\"32H5oapRpM57uELNCcVku8\", \"king_stud\"); closest of 62:"));
+    assert!(text.contains(
+        "  because:\n    fitted_role(\"32H5oapRpM57uELNCcVku8\", \"king_stud\") is not derived."
+    ));
+    assert!(text.contains("- king_beside_jack (rules/roles.dl:"));
+    assert!(text.contains("no upright fact matches upright(\"32H5oapRpM57uELNCcVku8\")"));
+    let json = ok(&[
+        "why-not",
+        m,
+        "role(#174, king_stud)",
+        "--json",
+        "--no-simulate",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["answer"], "not_derived");
+    let tree = &v["tree"];
+    assert_eq!(tree["why_not"]["relation"], "role");
+    let fitted = &tree["why_not"]["rules"][0];
+    assert_eq!(fitted["failure"]["kind"], "no_match");
+    assert_eq!(tree["because"][0]["why_not"]["relation"], "fitted_role");
+    assert_eq!(
+        tree["because"][0]["because"][0]["why_not"]["relation"],
+        "king_stud"
+    );
+    // A tuple that holds is explained instead.
+    let holds = ok(&[
+        "why-not",
+        m,
+        "role(#174, top_plate)",
+        "--json",
+        "--no-simulate",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&holds).unwrap();
+    assert_eq!(v["answer"], "holds");
+    assert_eq!(v["explanation"]["relation"], "role");
+}
+
+#[test]
+fn why_not_shows_the_numbers_of_a_failed_condition() {
+    // A member short enough for the user rule is not derived for a long stud:
+    // the failing comparison is shown with the stud's length and the spacing.
+    let model = root().join("tests/fixtures/synth_wall_door_window_in.ifc");
+    let rules = root().join("examples/rules/gripper_spacing.dl");
+    let text = ok(&[
+        "why-not",
+        model.to_str().unwrap(),
+        "violation(#105, shorter_than_gripper_spacing, \"x\")",
+        "--rules",
+        rules.to_str().unwrap(),
+        "--no-simulate",
+    ]);
+    assert!(text.contains("- shorter_than_gripper_spacing ("), "{text}");
+    assert!(
+        text.contains("condition `l < s` is false, e.g. 2.352675 < 0.6"),
+        "{text}"
+    );
+}
+
+#[test]
+fn bad_ids_and_tuples_exit_2_with_a_clear_message() {
+    let m = tm3();
+    let m = m.to_str().unwrap();
+    let err = bad(&["why", m, "#99999", "--no-simulate"]);
+    assert!(
+        err.contains("no piece of the model has the id `#99999` (nearest: #"),
+        "{err}"
+    );
+    assert!(
+        err.contains("`framewright plan MODEL.ifc --json` lists every member"),
+        "{err}"
+    );
+    let err = bad(&["why", m, "#x", "--no-simulate"]);
+    assert!(err.contains("`#x` is not an entity id"), "{err}");
+    let err = bad(&["why-not", m, "rol(#174, top_plate)", "--no-simulate"]);
+    assert!(
+        err.contains("unknown relation `rol`") && err.contains("did you mean `role`?"),
+        "{err}"
+    );
+    let err = bad(&["why-not", m, "role(#174)", "--no-simulate"]);
+    assert!(err.contains("`role` has 2 attribute(s), found 1"), "{err}");
+    let err = bad(&["why-not", m, "piece_index(#174, many)", "--no-simulate"]);
+    assert!(err.contains("cannot read the tuple"), "{err}");
+    let err = bad(&["why-not", m, "role(#5, stud)", "--no-simulate"]);
+    assert!(
+        err.contains("no piece of the model has the id `#5`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
+    // The study's finding: TM3's top plate cannot be placed on the ABB cell,
+    // its place pose is beyond the arm's reach. The executor simulates only
+    // the plate's wall; the second run reads it from the cache.
+    let cache = tempfile::tempdir().unwrap();
+    let m = tm3();
+    let args = [
+        "why",
+        m.to_str().unwrap(),
+        "#174",
+        "--cache-dir",
+        cache.path().to_str().unwrap(),
+    ];
+    let first = ok(&args);
+    assert!(
+        first.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"),
+        "{first}"
+    );
+    let reason = first.lines().nth(3).unwrap();
+    assert!(reason.starts_with("element_reason(\"32H5oapRpM57uELNCcVku8\", \"framing\", \"Robot\", \"place pose beyond reach: the wrist centre would be "), "{reason}");
+    assert!(
+        reason.contains(" m from the shoulder, the arm reaches 2.377 m ("),
+        "{reason}"
+    );
+    assert!(
+        reason.ends_with("[by framing_place_beyond_reach (rules/verdicts.dl:33)]"),
+        "{reason}"
+    );
+    assert!(
+        first.contains(
+            "sim_ik_failed(\"32H5oapRpM57uELNCcVku8\", \"place\", \"out_of_reach\", \"\", "
+        ),
+        "{first}"
+    );
+    assert!(
+        first.contains(
+            "[simulation: 07l14Rb8lVjg1i9SI4wpQJ IK for place of 32H5oapRpM57uELNCcVku8]"
+        ),
+        "{first}"
+    );
+    assert!(
+        first.contains("[by framing_target (rules/targets.dl:"),
+        "{first}"
+    );
+    assert!(
+        first.contains("cell_value(\"assembly_offset_x\", 0.531)"),
+        "{first}"
+    );
+    assert!(first.contains("[IFC #171]"), "{first}");
+    assert!(
+        first.contains("element_framing(\"32H5oapRpM57uELNCcVku8\", \"failed\")"),
+        "{first}"
+    );
+    let second = ok(&args);
+    assert!(second.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ (from the cache)\n"));
+    assert_eq!(
+        first.lines().skip(1).collect::<Vec<_>>(),
+        second.lines().skip(1).collect::<Vec<_>>()
+    );
+    let json = ok(&[&args[..], &["--json"]].concat());
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["simulated"][0]["from_cache"], true);
+    let verdicts = v["elements"][0]["verdicts"].as_array().unwrap();
+    let reason = verdicts
+        .iter()
+        .find(|x| x["relation"] == "element_reason")
+        .unwrap();
+    assert_eq!(reason["sources"]["simulation_facts"], 1);
+    assert!(
+        reason["sources"]["ifc_entities"]
+            .as_array()
+            .unwrap()
+            .contains(&serde_json::json!(174))
+    );
+}
