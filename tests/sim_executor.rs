@@ -201,3 +201,31 @@ fn an_unknown_wall_is_an_error_naming_the_walls() {
         "{message}"
     );
 }
+
+#[test]
+fn simulate_with_user_rules_adds_their_findings_to_the_elements() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(["simulate", "examples/models/tm1.ifc", "--json", "--rules"])
+        .arg(root.join("tests/fixtures/rules/placed_precisely.dl"))
+        .current_dir(root)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let elements = report["elements"].as_array().unwrap();
+    for e in elements {
+        let framed = e["framing"]["status"] == "framed";
+        let warned = e["rule_findings"].as_array().is_some_and(|f| {
+            f.iter()
+                .any(|f| f["rule"] == "placed_precisely" && f["kind"] == "warning")
+        });
+        // The rule fires exactly on the pieces placed within 2 mm: the framed ones.
+        assert_eq!(framed, warned, "{e}");
+    }
+    assert!(elements.iter().any(|e| e["framing"]["status"] == "framed"));
+}

@@ -7,6 +7,7 @@ use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::report::simulate::SimReport;
 use framewright::sim::{SimOptions, simulate_with_progress};
+use framewright::user_rules::UserRules;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
@@ -29,6 +30,10 @@ pub struct SimulateArgs {
     /// Replace the built-in rule base with every .dl file of this directory.
     #[arg(long, value_name = "DIR")]
     pub rules_dir: Option<PathBuf>,
+    /// Your rule file (violation/warning rules, see docs/RULES.md) run over the built-in and
+    /// simulation relations; its findings join the element verdicts. Repeat for more.
+    #[arg(long = "rules", value_name = "FILE.dl")]
+    pub rules: Vec<PathBuf>,
     /// Physics time step, milliseconds.
     #[arg(long, value_name = "MS", default_value_t = 1000.0 / 240.0)]
     pub step_ms: f64,
@@ -48,6 +53,11 @@ pub fn run(args: SimulateArgs) -> CmdResult {
             .rules_dir
             .map_or(RuleEngine::Compiled, RuleEngine::Directory),
     };
+    let user_rules = if args.rules.is_empty() {
+        None
+    } else {
+        Some(UserRules::load(&args.rules, &options.engine)?)
+    };
     let name = args.model.file_name().map_or_else(
         || args.model.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
@@ -57,7 +67,10 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         bars.update(wall, done, total)
     })?;
     bars.finish();
-    let report = SimReport::new(&sim, options.dt);
+    let mut report = SimReport::new(&sim, options.dt);
+    if let Some(rules) = &user_rules {
+        report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
+    }
     if args.json {
         write_stdout(|out| report.write_json(out))
     } else {

@@ -16,9 +16,9 @@ pub use facts::{Facts, model_facts};
 
 #[derive(Debug, thiserror::Error)]
 pub enum FrameError {
-    #[error("{0}")]
+    #[error(transparent)]
     Rules(#[from] Diagnostics),
-    #[error("{0}")]
+    #[error(transparent)]
     Logic(#[from] LogicError),
     #[error("the compiled rule base failed: {0}")]
     Compiled(String),

@@ -53,6 +53,17 @@ pub struct ElementRow {
     pub role: String,
     pub framing: ElementStage,
     pub nailing: ElementStage,
+    /// Violations and warnings of the user's rules (`simulate --rules`) about this element.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rule_findings: Vec<RuleFinding>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct RuleFinding {
+    /// violation | warning
+    pub kind: String,
+    pub rule: String,
+    pub message: String,
 }
 
 #[derive(Debug, Serialize)]
@@ -214,6 +225,7 @@ impl SimReport {
                     role: sim.plan.roles.get(id).cloned().unwrap_or_default(),
                     framing: stage("framing", &framing),
                     nailing: stage("nailing", &nailing),
+                    rule_findings: Vec::new(),
                 });
             }
         }
@@ -292,6 +304,20 @@ impl SimReport {
         }
     }
 
+    /// Adds the user rules' findings to the elements they are about.
+    pub fn add_findings(&mut self, findings: &crate::user_rules::Findings) {
+        for e in &mut self.elements {
+            e.rule_findings = findings
+                .about(&e.id)
+                .map(|(kind, f)| RuleFinding {
+                    kind: kind.to_string(),
+                    rule: f.rule.clone(),
+                    message: f.message.clone(),
+                })
+                .collect();
+        }
+    }
+
     pub fn write_json(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
         serde_json::to_writer_pretty(&mut *out, self)?;
         writeln!(out)
@@ -351,6 +377,21 @@ impl SimReport {
                         e.id, e.role, stage, first.component, first.message, more
                     );
                 }
+            }
+        }
+        let findings: Vec<(&ElementRow, &RuleFinding)> = self
+            .elements
+            .iter()
+            .flat_map(|e| e.rule_findings.iter().map(move |f| (e, f)))
+            .collect();
+        if !findings.is_empty() {
+            let _ = writeln!(s, "\nyour rules found:");
+            for (e, f) in findings {
+                let _ = writeln!(
+                    s,
+                    "  {} {:<13} {} {}: {}",
+                    e.id, e.role, f.kind, f.rule, f.message
+                );
             }
         }
         let v = &self.nailing_validation;

@@ -48,9 +48,9 @@ impl Default for SimOptions {
 
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
-    #[error("{0}")]
+    #[error(transparent)]
     World(#[from] WorldError),
-    #[error("{0}")]
+    #[error(transparent)]
     Frame(#[from] FrameError),
     #[error("no wall `{name}` in the model; its walls are: {known}")]
     UnknownWall { name: String, known: String },

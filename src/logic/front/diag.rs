@@ -69,7 +69,7 @@ impl fmt::Display for Diagnostic {
             self.source_line
                 .chars()
                 .count()
-                .saturating_sub(self.col as usize - 1)
+                .saturating_sub((self.col as usize).saturating_sub(1))
                 .max(1),
         );
         writeln!(f, "{pad} | {lead}{}", "^".repeat(width.max(1)))?;
