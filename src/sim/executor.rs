@@ -394,6 +394,11 @@ impl<'a> WallRun<'a> {
         let Some((piece, op, allowed)) = &self.current else {
             return;
         };
+        // While the robot waits for a piece it stands still: what it touches does not change
+        // (a contact it is still in is recorded by the next operation).
+        if *op == "feed" {
+            return;
+        }
         let held = self.held.as_ref().map(|h| h.id.as_str());
         for (a, b, depth) in self.phys.robot_contacts(held, CONTACT_TOLERANCE) {
             if allowed.contains(&b) || self.resting.contains(&(a.clone(), b.clone())) {
