@@ -613,12 +613,10 @@ impl<'a> WallRun<'a> {
                 &grip,
             )
             .is_ok();
-        self.phys.set_jaws(Some(piece.size[2]));
-        self.wait(GRIP_TIME);
         let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
         let body = self.phys.lumber_pose(id).unwrap_or(piece.spawn);
-        // The jaws closed where the plan expected the piece; if it was not there (it moved
-        // after the plan, or the jaws pushed it), the grip failed.
+        // The jaws close where the plan expected the piece; if it is not there (it moved after
+        // the plan), the grip fails.
         let expected = plan.pick * grip.inverse();
         let offset = (body.translation.vector
             - (tool * expected.inverse() * plan.pick_body)
@@ -647,7 +645,11 @@ impl<'a> WallRun<'a> {
             self.take_off(id);
             return;
         }
+        // Hold the piece where it lies, then close the jaws on it: finger plates jumping shut
+        // on a free piece would knock it over.
         self.phys.attach(id);
+        self.phys.set_jaws(Some(piece.size[2]));
+        self.wait(GRIP_TIME);
         self.held = Some(Held {
             id: id.to_string(),
             in_tool: tool.inverse() * body,
