@@ -40,6 +40,8 @@ const SETTLE_TIME: f64 = 1.0;
 /// A piece that ran into the sensor's end stop settles this long before the robot plans its
 /// grip (s).
 const SENSOR_SETTLE: f64 = 0.5;
+/// The longest the executor waits for a piece at the sensor to come to rest (s).
+const MAX_SENSOR_SETTLE: f64 = 3.0;
 
 /// One nail as the executor drives it.
 #[derive(Debug, Clone)]
@@ -568,7 +570,29 @@ impl<'a> WallRun<'a> {
             return;
         }
         self.record.fed.push((piece.id.clone(), self.t));
+        // Let the piece come to rest against the end stop before planning the grip.
         self.wait(SENSOR_SETTLE);
+        let mut waited = SENSOR_SETTLE;
+        while waited < MAX_SENSOR_SETTLE
+            && self
+                .phys
+                .lumber_speed(&piece.id)
+                .is_some_and(|(v, w)| v > 1e-3 || w > 1e-2)
+        {
+            self.wait(0.1);
+            waited += 0.1;
+        }
+        if let Some(pose) = self.phys.lumber_pose(&piece.id)
+            && piece.on_edge
+            && (pose.rotation * Vector3::y()).z.abs() < 0.9
+        {
+            self.record.grip_failed.push((
+                piece.id.clone(),
+                "it toppled over at the end stop of conveyor 2 (it lies on its wide face); the gripper takes lumber standing on edge".into(),
+            ));
+            self.take_off(&piece.id);
+            return;
+        }
         if let Err(why) = self.grip_check(piece) {
             self.record.grip_failed.push((piece.id.clone(), why));
             self.take_off(&piece.id);

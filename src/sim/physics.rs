@@ -372,6 +372,16 @@ impl Physics {
         Some(to_iso(self.world.bodies[b.body].position()))
     }
 
+    /// Linear (m/s) and angular (rad/s) speed of a piece.
+    pub fn lumber_speed(&self, id: &str) -> Option<(f64, f64)> {
+        let b = self.lumber.get(id)?;
+        let body = &self.world.bodies[b.body];
+        Some((
+            f64::from(body.linvel().length()),
+            f64::from(body.angvel().length()),
+        ))
+    }
+
     /// Moves the robot's bodies to joint values `q` by the end of the next step.
     pub fn drive_robot(&mut self, q: &[f64]) {
         let poses = self.cell.robot.fk_all(q);
