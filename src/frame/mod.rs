@@ -53,8 +53,8 @@ impl Reasoned {
     }
 }
 
-/// Every `.dl` file of `dir`, sorted, as one program.
-pub fn directory_program(dir: &Path) -> Result<Program, FrameError> {
+/// The `.dl` files of a rules directory, sorted (an error when it cannot be read or holds none).
+pub fn directory_files(dir: &Path) -> Result<Vec<PathBuf>, FrameError> {
     let entries = std::fs::read_dir(dir).map_err(|e| FrameError::RulesDir {
         path: dir.to_path_buf(),
         message: e.to_string(),
@@ -70,7 +70,12 @@ pub fn directory_program(dir: &Path) -> Result<Program, FrameError> {
             message: "it holds no .dl files".into(),
         });
     }
-    Ok(Program::parse_files(&files)?)
+    Ok(files)
+}
+
+/// Every `.dl` file of `dir`, sorted, as one program.
+pub fn directory_program(dir: &Path) -> Result<Program, FrameError> {
+    Ok(Program::parse_files(&directory_files(dir)?)?)
 }
 
 /// Runs the rule base over the facts.

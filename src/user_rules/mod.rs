@@ -291,22 +291,15 @@ fn load_base(loader: &mut Loader<'_>, base: &RuleEngine) -> Result<(), UserRules
 
 /// The `.dl` files of a rules directory, sorted.
 pub fn directory_files(dir: &Path) -> Result<Vec<PathBuf>, UserRulesError> {
-    let entries = std::fs::read_dir(dir).map_err(|e| UserRulesError::RulesDir {
-        path: dir.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    let mut files: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "dl"))
-        .collect();
-    files.sort();
-    if files.is_empty() {
-        return Err(UserRulesError::RulesDir {
+    crate::frame::directory_files(dir).map_err(|e| match e {
+        crate::frame::FrameError::RulesDir { path, message } => {
+            UserRulesError::RulesDir { path, message }
+        }
+        other => UserRulesError::RulesDir {
             path: dir.to_path_buf(),
-            message: "it holds no .dl files".into(),
-        });
-    }
-    Ok(files)
+            message: other.to_string(),
+        },
+    })
 }
 
 /// Number of prelude sources `input_prelude` makes (one per base source).
