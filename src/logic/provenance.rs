@@ -532,13 +532,7 @@ impl Explanation {
                 let _ = writeln!(s, "{first}{head}  [by {rule}]");
                 for (i, p) in premises.iter().enumerate() {
                     let last = i + 1 == premises.len();
-                    let (f, r) = if last {
-                        ("└─ ", "   ")
-                    } else {
-                        ("├─ ", "│  ")
-                    };
-                    let f = format!("{rest}{f}");
-                    let r = format!("{rest}{r}");
+                    let (f, r) = tree_branch(rest, last);
                     match p {
                         Premise::Tuple(e) => e.render_into(s, &f, &r),
                         Premise::Absent { atom } => {
@@ -666,4 +660,14 @@ pub fn parse_query(
         vals.push(Value::parse(a.ty, f).map_err(|m| bad(&m))?);
     }
     Ok((name.to_string(), vals))
+}
+
+/// The prefixes of a tree child under `rest`: its own line and the lines below it.
+pub fn tree_branch(rest: &str, last: bool) -> (String, String) {
+    let (first, below) = if last {
+        ("└─ ", "   ")
+    } else {
+        ("├─ ", "│  ")
+    };
+    (format!("{rest}{first}"), format!("{rest}{below}"))
 }

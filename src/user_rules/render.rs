@@ -152,13 +152,7 @@ fn render_node(
             let lines = children(premises);
             for (i, line) in lines.iter().enumerate() {
                 let last = i + 1 == lines.len();
-                let (f, r) = if last {
-                    ("└─ ", "   ")
-                } else {
-                    ("├─ ", "│  ")
-                };
-                let f = format!("{rest}{f}");
-                let r = format!("{rest}{r}");
+                let (f, r) = crate::logic::provenance::tree_branch(rest, last);
                 match line {
                     Child::Node(t) => render_node(s, t, &f, &r, depth + 1, shown),
                     Child::Text(t) => {
