@@ -26,6 +26,11 @@ const CLEARANCE: f64 = 0.25;
 const RELEASE_GAP: f64 = 0.001;
 /// The nailer approaches along the nail line from this far back (m).
 const NAIL_APPROACH: f64 = 0.10;
+/// Where the straight line back along the nail is out of reach (a nail driven towards the
+/// robot at the far edge of its reach), the nailer comes down to the nail from this far
+/// above it instead, its nose this far off the face until the last stretch (m).
+const NAIL_DESCENT: f64 = 0.10;
+const NAIL_STANDOFF: f64 = 0.01;
 const GRIP_TIME: f64 = 0.5;
 const RELEASE_TIME: f64 = 0.3;
 const FIRE_TIME: f64 = 0.2;
@@ -888,11 +893,13 @@ impl<'a> WallRun<'a> {
             }
             let point = self.wall_cell * Point3::from(Vector3::from(nail.uvw));
             let direction = self.wall_cell.rotation * nail.direction;
-            let mut chosen: Option<(Isometry3<f64>, Vec<f64>)> = None;
+            let mut chosen: Option<(Isometry3<f64>, Isometry3<f64>, Vec<f64>)> = None;
             let mut miss: Option<(f64, IkFailure)> = None;
-            for roll in nail_rolls() {
+            let candidates = nail_rolls().into_iter().flat_map(|roll| {
                 let pose = nail_pose(&point, &direction, roll);
-                let back = retreat(&pose, NAIL_APPROACH);
+                nail_approaches(pose).map(move |back| (pose, back))
+            });
+            for (pose, back) in candidates {
                 let attempt = solve(self.cell, &back, &nail_tcp, &self.q).and_then(|qa| {
                     let q_nail = line(self.cell, &qa, &back, &pose, &nail_tcp, 4)?;
                     let ignore = [nail.plate.as_str(), nail.member.as_str()];
@@ -905,7 +912,7 @@ impl<'a> WallRun<'a> {
                 });
                 match attempt {
                     Ok(q_back) => {
-                        chosen = Some((pose, q_back));
+                        chosen = Some((pose, back, q_back));
                         break;
                     }
                     Err(f) => {
@@ -916,7 +923,7 @@ impl<'a> WallRun<'a> {
                     }
                 }
             }
-            let Some((pose, q_back)) = chosen else {
+            let Some((pose, back, q_back)) = chosen else {
                 let failure = miss.map_or(IkFailure::InvalidPose, |m| m.1);
                 let (kind, what, value, limit) = failure_columns(&failure);
                 self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
@@ -925,7 +932,6 @@ impl<'a> WallRun<'a> {
             let plate = nail.plate.clone();
             let start = self.begin(&plate, "nail", &[nail.member.as_str()]);
             self.move_to(&q_back, &nail_tcp, &[]);
-            let back = retreat(&pose, NAIL_APPROACH);
             let reached = self
                 .run_line(
                     &LinearMove::new(back, pose, LINE_SPEED, LINE_ACCEL),
@@ -1171,6 +1177,23 @@ fn box_symmetries() -> [Isometry3<f64>; 4] {
 fn nail_rolls() -> [f64; 6] {
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
     [0.0, FRAC_PI_4, -FRAC_PI_4, FRAC_PI_2, -FRAC_PI_2, PI]
+}
+
+/// Where the nailer starts its straight approach to a nail pose, in the order tried: back
+/// along the nail line, then (for a nail not driven vertically) from above, just off the face.
+fn nail_approaches(pose: Isometry3<f64>) -> impl Iterator<Item = Isometry3<f64>> {
+    let along = retreat(&pose, NAIL_APPROACH);
+    let drive = pose.rotation * Vector3::z();
+    let up = Vector3::z() - drive * drive.z;
+    let from_above = (up.norm() > 0.5).then(|| {
+        let lift = up.normalize() * NAIL_DESCENT;
+        let off = retreat(&pose, NAIL_STANDOFF);
+        Isometry3::from_parts(
+            Translation3::from(off.translation.vector + lift),
+            pose.rotation,
+        )
+    });
+    std::iter::once(along).chain(from_above)
 }
 
 /// The nail TCP at `point` driving along `direction`, its x axis turned `roll` from up.
