@@ -182,6 +182,33 @@ fn a_tool_table_in_the_arm_s_path_is_reported_with_bodies_and_time() {
 }
 
 #[test]
+fn the_arm_does_not_knock_lumber_off_the_belt_on_its_way_to_a_pick() {
+    // On the KUKA cell the tool swung low over conveyor 2 on its way above a stud and a jaw
+    // grazed it (0.2 mm), knocking it over: moves now keep a margin from everything.
+    let (sim, report) = run("tm2.ifc", "study-kuka", &[]);
+    let text = report.to_text();
+    assert!(report.contacts.is_empty(), "{text}");
+    let studs: Vec<_> = report
+        .elements
+        .iter()
+        .filter(|e| e.role == "stud")
+        .collect();
+    assert_eq!(studs.len(), 2);
+    for e in &studs {
+        assert_eq!(e.framing.status, "framed", "{text}");
+    }
+    assert!(!report.walls[0].framing.failed_component.contains("Gripper"));
+    for p in &sim.records[0].placements {
+        assert!(
+            p.position_error <= 0.002,
+            "{} off by {} m",
+            p.piece,
+            p.position_error
+        );
+    }
+}
+
+#[test]
 fn two_runs_give_byte_identical_json() {
     let (_, a) = run("tm1.ifc", "study-abb", &[]);
     let (_, b) = run("tm1.ifc", "study-abb", &[]);

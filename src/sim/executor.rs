@@ -22,6 +22,11 @@ use std::collections::{BTreeMap, BTreeSet, VecDeque};
 const CONTACT_TOLERANCE: f64 = 0.001;
 /// Height above the pick and place poses the gripper approaches from (m).
 const CLEARANCE: f64 = 0.25;
+/// How far the arm, its tool and a held piece keep from everything on a move between poses
+/// (m): a kinematic arm grazing a piece on the belt knocks it over.
+const PATH_MARGIN: f64 = 0.005;
+/// Largest travel of any point of the arm between two checked samples of a move (m).
+const SWEEP_STEP: f64 = 0.02;
 /// A piece is released this far above its target and drops into place (m).
 const RELEASE_GAP: f64 = 0.001;
 /// The nailer approaches along the nail line from this far back (m).
@@ -353,31 +358,69 @@ impl<'a> WallRun<'a> {
         Some(path)
     }
 
+    /// Whether the arm sweeps along `path` (straight in joint space between waypoints) at
+    /// least PATH_MARGIN clear of everything: checked at samples no further apart than
+    /// SWEEP_STEP for the fastest-moving point of the arm, its tool and a held piece.
     fn path_clear(&self, path: &[Vec<f64>], ignore: &[&str]) -> bool {
         let held = self
             .held
             .as_ref()
             .map(|h| (h.id.as_str(), &h.in_tool, h.half));
         for leg in path.windows(2) {
-            let travel = leg[0]
-                .iter()
-                .zip(&leg[1])
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            let samples = (travel / 0.03).ceil().max(1.0) as usize;
+            let samples = (self.sweep_length(&leg[0], &leg[1]) / SWEEP_STEP)
+                .ceil()
+                .max(1.0) as usize;
             for k in 0..=samples {
-                let s = k as f64 / samples as f64;
-                let q: Vec<f64> = leg[0]
-                    .iter()
-                    .zip(&leg[1])
-                    .map(|(a, b)| a + (b - a) * s)
-                    .collect();
-                if touches(&self.phys, self.cell, &q, held, ignore).is_some() {
+                let q = lerp(&leg[0], &leg[1], k as f64 / samples as f64);
+                if touches(&self.phys, self.cell, &q, held, ignore, PATH_MARGIN).is_some() {
                     return false;
                 }
             }
         }
         true
+    }
+
+    /// How far the fastest-moving of the arm's key points travels on the joint-space line
+    /// from `a` to `b` (m), measured over a few sub-steps: link origins, tool part centres and
+    /// the ends of a held piece.
+    fn sweep_length(&self, a: &[f64], b: &[f64]) -> f64 {
+        const SUB_STEPS: usize = 8;
+        let points = |q: &[f64]| -> Vec<Vector3<f64>> {
+            let base = self.cell.robot_base;
+            let tool = base * self.cell.robot.fk_tip(q);
+            let mut pts: Vec<Vector3<f64>> = self
+                .cell
+                .robot
+                .fk_all(q)
+                .iter()
+                .map(|p| (base * p).translation.vector)
+                .collect();
+            pts.extend(
+                self.cell
+                    .tool
+                    .parts
+                    .iter()
+                    .map(|p| (tool * p.shape.origin).translation.vector),
+            );
+            if let Some(h) = &self.held {
+                for end in [-h.half[0], h.half[0]] {
+                    pts.push((tool * h.in_tool * Point3::new(end, 0.0, 0.0)).coords);
+                }
+            }
+            pts
+        };
+        let mut before = points(a);
+        let mut total = 0.0;
+        for k in 1..=SUB_STEPS {
+            let now = points(&lerp(a, b, k as f64 / SUB_STEPS as f64));
+            total += before
+                .iter()
+                .zip(&now)
+                .map(|(p, n)| (n - p).norm())
+                .fold(0.0, f64::max);
+            before = now;
+        }
+        total
     }
 
     fn begin(&mut self, piece: &str, op: &'static str, may_touch: &[&str]) -> f64 {
@@ -833,9 +876,9 @@ impl<'a> WallRun<'a> {
                         let held_in_tool = grip * in_body.inverse();
                         let half = piece.size.map(|v| v / 2.0);
                         let held = Some((piece.id.as_str(), &held_in_tool, half));
-                        let blocked =
-                            touches(&self.phys, self.cell, &q_place, held, &[]).or_else(|| {
-                                touches(&self.phys, self.cell, &q_pick, None, &[&piece.id])
+                        let blocked = touches(&self.phys, self.cell, &q_place, held, &[], 0.0)
+                            .or_else(|| {
+                                touches(&self.phys, self.cell, &q_pick, None, &[&piece.id], 0.0)
                             });
                         if let Some((a, b)) = blocked {
                             // A reachable pose that collides: the closest kind of miss.
@@ -903,8 +946,8 @@ impl<'a> WallRun<'a> {
                 let attempt = solve(self.cell, &back, &nail_tcp, &self.q).and_then(|qa| {
                     let q_nail = line(self.cell, &qa, &back, &pose, &nail_tcp, 4)?;
                     let ignore = [nail.plate.as_str(), nail.member.as_str()];
-                    match touches(&self.phys, self.cell, &q_nail, None, &ignore)
-                        .or_else(|| touches(&self.phys, self.cell, &qa, None, &ignore))
+                    match touches(&self.phys, self.cell, &q_nail, None, &ignore, 0.0)
+                        .or_else(|| touches(&self.phys, self.cell, &qa, None, &ignore, 0.0))
                     {
                         Some((a, b)) => Err(IkFailure::AllSolutionsCollide { pair: [a, b] }),
                         None => Ok(qa),
@@ -1227,6 +1270,10 @@ fn failure_score(f: &IkFailure) -> f64 {
         IkFailure::AllSolutionsCollide { .. } => -1.0,
         _ => 10.0,
     }
+}
+
+fn lerp(a: &[f64], b: &[f64], s: f64) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x + (y - x) * s).collect()
 }
 
 fn distance(a: &[f64], b: &[f64]) -> f64 {

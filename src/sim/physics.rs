@@ -485,7 +485,8 @@ impl Physics {
     }
 
     /// Contacts of the robot, its tool and the piece `held` with anything else, deeper than
-    /// `tolerance`: (body, other body, depth), excluding the held piece against the tool.
+    /// `tolerance` (any depth between the arm or tool and lumber): (body, other body, depth), excluding the held
+    /// piece against the tool.
     pub fn robot_contacts(&self, held: Option<&str>, tolerance: f64) -> Vec<(String, String, f64)> {
         let held_collider = held.and_then(|id| self.lumber.get(id)).map(|b| b.collider);
         let mut found = Vec::new();
@@ -505,7 +506,14 @@ impl Physics {
                     continue;
                 };
                 let depth = -f64::from(contact.dist);
-                if depth > tolerance {
+                // Any touch of the arm or tool on a piece counts: a graze knocks it over.
+                // A held piece set down against its neighbours may touch them.
+                let limit = if Some(c) != held_collider && self.lumber_of.contains_key(&other) {
+                    0.0
+                } else {
+                    tolerance
+                };
+                if depth > limit {
                     found.push((self.name(c), self.name(other), depth));
                 }
             }

@@ -67,13 +67,15 @@ pub fn line(
 
 /// What the arm would touch at joint values `q` holding `held` (its id, its pose in tool0 and
 /// its box half sizes): the first (robot body, other body) pair found, ignoring the bodies
-/// in `ignore` and sensors.
+/// in `ignore` and sensors. With `margin` > 0 the arm, tool and held piece are dilated by it:
+/// a pair closer than `margin` counts as touching.
 pub fn touches(
     phys: &Physics,
     cell: &Cell,
     q: &[f64],
     held: Option<(&str, &Isometry3<f64>, [f64; 3])>,
     ignore: &[&str],
+    margin: f64,
 ) -> Option<(String, String)> {
     let world = &phys.world;
     let poses = cell.robot.fk_all(q);
@@ -124,13 +126,16 @@ pub fn touches(
         let filter = QueryFilter::default()
             .groups(collider.collision_groups())
             .predicate(&predicate);
-        if let Some(other) = hit(body * local, collider.shape(), filter) {
+        let dilated = dilate(collider.shape(), margin);
+        let shape = dilated.as_ref().map_or(collider.shape(), |s| s.as_ref());
+        if let Some(other) = hit(body * local, shape, filter) {
             return Some((phys.name(c), other));
         }
     }
     if let Some((id, in_tool, half)) = held {
         // Shrunk by 2 mm: a placed piece may touch its neighbours.
-        let h = half.map(|v| (v - 0.002).max(0.001) as f32);
+        // Grown by the margin as a box (corners a little more cautious than a dilation).
+        let h = half.map(|v| ((v - 0.002).max(0.001) + margin.max(0.0)) as f32);
         let shape = Cuboid::new(Vector::new(h[0], h[1], h[2]));
         let filter = QueryFilter::default().predicate(&predicate);
         if let Some(other) = hit(tool * in_tool, &shape, filter) {
@@ -138,4 +143,28 @@ pub fn touches(
         }
     }
     None
+}
+
+/// The shape grown by `margin` on every side (its Minkowski sum with a ball), for the shapes
+/// robots and tools are made of; None when there is nothing to grow.
+fn dilate(shape: &dyn rapier3d::parry::shape::Shape, margin: f64) -> Option<SharedShape> {
+    if margin <= 0.0 {
+        return None;
+    }
+    let m = margin as f32;
+    if let Some(b) = shape.as_cuboid() {
+        let h = b.half_extents;
+        Some(SharedShape::round_cuboid(h.x, h.y, h.z, m))
+    } else if let Some(c) = shape.as_cylinder() {
+        Some(SharedShape::round_cylinder(c.half_height, c.radius, m))
+    } else if let Some(b) = shape.as_ball() {
+        Some(SharedShape::ball(b.radius + m))
+    } else if let Some(c) = shape.as_capsule() {
+        Some(SharedShape::capsule(c.segment.a, c.segment.b, c.radius + m))
+    } else {
+        shape.as_round_cuboid().map(|r| {
+            let h = r.inner_shape.half_extents;
+            SharedShape::round_cuboid(h.x, h.y, h.z, r.border_radius + m)
+        })
+    }
 }
