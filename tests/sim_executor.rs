@@ -208,6 +208,71 @@ fn the_arm_does_not_knock_lumber_off_the_belt_on_its_way_to_a_pick() {
     }
 }
 
+/// The shipped cell with the wall on a framing table `height` m high instead of the floor.
+fn on_a_framing_table(cell: &str, height: f64, dir: &Path) -> String {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("robots/cells/{cell}.toml"));
+    let text = std::fs::read_to_string(shipped).unwrap();
+    assert!(
+        text.contains("\nsurface_z = 0.0 "),
+        "the shipped cell lays the wall on the floor"
+    );
+    let path = dir.join(format!("{cell}-table.toml"));
+    std::fs::write(
+        &path,
+        text.replace("\nsurface_z = 0.0 ", &format!("\nsurface_z = {height} ")),
+    )
+    .unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn tm1_completes_on_both_robots_when_the_wall_lies_on_a_framing_table() {
+    // On the floor the bottom plate lies 0.55 m from the base axis, where neither arm can
+    // fold far enough (joint 3 limit); on a 0.6 m table both frame and nail the whole wall.
+    let dir = tempfile::tempdir().unwrap();
+    for cell in ["study-abb", "study-kuka"] {
+        let (floor_sim, floor) = run("tm1.ifc", cell, &[]);
+        assert_eq!(floor.walls[0].framing.status, "Partial", "{cell}");
+        let bottom = floor
+            .elements
+            .iter()
+            .find(|e| e.role == "bottom_plate")
+            .unwrap();
+        assert!(
+            bottom.framing.reasons[0].message.contains("joint limit"),
+            "{cell}: {:?}",
+            bottom.framing.reasons
+        );
+        drop(floor_sim);
+
+        let (sim, report) = run("tm1.ifc", &on_a_framing_table(cell, 0.6, dir.path()), &[]);
+        let text = report.to_text();
+        assert_eq!(
+            report.walls[0].framing.status, "Completed",
+            "{cell}: {text}"
+        );
+        assert_eq!(
+            report.walls[0].nailing.status, "Completed",
+            "{cell}: {text}"
+        );
+        assert!(report.contacts.is_empty(), "{cell}: {text}");
+        let placements = &sim.records[0].placements;
+        assert_eq!(placements.len(), 4);
+        for p in placements {
+            assert!(
+                p.position_error <= 0.002,
+                "{cell}: {} off by {} m",
+                p.piece,
+                p.position_error
+            );
+            // Within 2 mm of a target on the table top: the table holds the wall up.
+            assert!(p.angle_error <= 1f64.to_radians());
+        }
+        assert_eq!(report.nailing_validation.checked, 8);
+        assert!(report.nailing_validation.max_error_mm < 2.0);
+    }
+}
+
 #[test]
 fn two_runs_give_byte_identical_json() {
     let (_, a) = run("tm1.ifc", "study-abb", &[]);

@@ -22,6 +22,10 @@ use std::collections::{BTreeMap, BTreeSet, VecDeque};
 const CONTACT_TOLERANCE: f64 = 0.001;
 /// Height above the pick and place poses the gripper approaches from (m).
 const CLEARANCE: f64 = 0.25;
+/// An assembly surface this far or less above the floor is the floor itself (m).
+const SURFACE_ON_FLOOR: f64 = 0.005;
+/// How far a framing table reaches beyond the wall laid on it (m).
+const TABLE_BORDER: f64 = 0.05;
 /// How far the arm, its tool and a held piece keep from everything on a move between poses
 /// (m): a kinematic arm grazing a piece on the belt knocks it over.
 const PATH_MARGIN: f64 = 0.005;
@@ -153,7 +157,16 @@ impl<'a> WallRun<'a> {
         progress: &'a (dyn Fn(usize, usize) + Sync),
     ) -> WallRun<'a> {
         let q = cell.robot.home();
-        let phys = Physics::new(cell, &q, options.dt);
+        let mut phys = Physics::new(cell, &q, options.dt);
+        if cell.assembly.surface_z > cell.floor.z + SURFACE_ON_FLOOR
+            && let Some((min, max)) = footprint(&pieces)
+        {
+            phys.add_assembly_table(
+                [min[0] - TABLE_BORDER, min[1] - TABLE_BORDER],
+                [max[0] + TABLE_BORDER, max[1] + TABLE_BORDER],
+                cell.assembly.surface_z,
+            );
+        }
         WallRun {
             cell,
             options,
@@ -1270,6 +1283,27 @@ fn failure_score(f: &IkFailure) -> f64 {
         IkFailure::AllSolutionsCollide { .. } => -1.0,
         _ => 10.0,
     }
+}
+
+/// The cell-frame x/y rectangle the pieces cover at their framing targets.
+fn footprint(pieces: &[&ScenePiece]) -> Option<([f64; 2], [f64; 2])> {
+    let mut corners = pieces.iter().flat_map(|p| {
+        let [l, w, t] = p.size.map(|v| v / 2.0);
+        [-1.0, 1.0].into_iter().flat_map(move |a| {
+            [-1.0, 1.0].into_iter().flat_map(move |b| {
+                [-1.0, 1.0]
+                    .into_iter()
+                    .map(move |c| p.target_cell * Point3::new(a * l, b * w, c * t))
+            })
+        })
+    });
+    let first = corners.next()?;
+    let (mut min, mut max) = ([first.x, first.y], [first.x, first.y]);
+    for c in corners {
+        min = [min[0].min(c.x), min[1].min(c.y)];
+        max = [max[0].max(c.x), max[1].max(c.y)];
+    }
+    Some((min, max))
 }
 
 fn lerp(a: &[f64], b: &[f64], s: f64) -> Vec<f64> {

@@ -393,6 +393,31 @@ impl Physics {
         self.world.bodies[self.tool].set_next_kinematic_position(to_pose(&tool));
     }
 
+    /// A framing table under the wall when the cell's assembly surface is above the floor:
+    /// a solid block from the floor to `top` over the cell-frame rectangle `min`..`max`.
+    pub fn add_assembly_table(&mut self, min: [f64; 2], max: [f64; 2], top: f64) {
+        let floor = self.cell.floor.z;
+        let height = top - floor;
+        if height <= 0.0 {
+            return;
+        }
+        let centre = Isometry3::translation(
+            (min[0] + max[0]) / 2.0,
+            (min[1] + max[1]) / 2.0,
+            floor + height / 2.0,
+        );
+        let (_, c) = self.world.insert(
+            RigidBodyBuilder::fixed().pose(to_pose(&centre)),
+            ColliderBuilder::cuboid(
+                ((max[0] - min[0]) / 2.0) as f32,
+                ((max[1] - min[1]) / 2.0) as f32,
+                (height / 2.0) as f32,
+            )
+            .collision_groups(groups(FIXED, LUMBER | ROBOT)),
+        );
+        self.names.insert(c, "assembly table".into());
+    }
+
     /// Opens the jaws (`None`) or closes them on lumber of this thickness.
     pub fn set_jaws(&mut self, closed_on: Option<f64>) {
         let open = self
