@@ -208,20 +208,25 @@ fn the_arm_does_not_knock_lumber_off_the_belt_on_its_way_to_a_pick() {
     }
 }
 
-/// The shipped cell with the wall on a framing table `height` m high instead of the floor.
-fn on_a_framing_table(cell: &str, height: f64, dir: &Path) -> String {
+/// The shipped cell with one line of its file replaced (the line starting with `key = `).
+fn shipped_cell_with(cell: &str, key: &str, value: f64, dir: &Path) -> String {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("robots/cells/{cell}.toml"));
     let text = std::fs::read_to_string(shipped).unwrap();
-    assert!(
-        text.contains("\nsurface_z = 0.0 "),
-        "the shipped cell lays the wall on the floor"
-    );
-    let path = dir.join(format!("{cell}-table.toml"));
-    std::fs::write(
-        &path,
-        text.replace("\nsurface_z = 0.0 ", &format!("\nsurface_z = {height} ")),
-    )
-    .unwrap();
+    let mut replaced = 0;
+    let lines: Vec<String> = text
+        .lines()
+        .map(|l| {
+            if l.starts_with(&format!("{key} = ")) {
+                replaced += 1;
+                format!("{key} = {value}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    assert_eq!(replaced, 1, "{cell} has one `{key}` line");
+    let path = dir.join(format!("{cell}-{key}-{value}.toml"));
+    std::fs::write(&path, lines.join("\n")).unwrap();
     path.to_str().unwrap().to_string()
 }
 
@@ -245,7 +250,8 @@ fn tm1_completes_on_both_robots_when_the_wall_lies_on_a_framing_table() {
         );
         drop(floor_sim);
 
-        let (sim, report) = run("tm1.ifc", &on_a_framing_table(cell, 0.6, dir.path()), &[]);
+        let table = shipped_cell_with(cell, "surface_z", 0.6, dir.path());
+        let (sim, report) = run("tm1.ifc", &table, &[]);
         let text = report.to_text();
         assert_eq!(
             report.walls[0].framing.status, "Completed",
@@ -271,6 +277,29 @@ fn tm1_completes_on_both_robots_when_the_wall_lies_on_a_framing_table() {
         assert_eq!(report.nailing_validation.checked, 8);
         assert!(report.nailing_validation.max_error_mm < 2.0);
     }
+}
+
+#[test]
+fn nailing_does_not_shift_the_placed_frame() {
+    // With the wall 0.80 m out the ABB reaches TM1's bottom plate and nails into it from the
+    // robot's side; the nailer must not push the frame across the floor (the fixture holds
+    // placed pieces).
+    let dir = tempfile::tempdir().unwrap();
+    let cell = shipped_cell_with("study-abb", "offset_x", 0.8, dir.path());
+    let (sim, report) = run("tm1.ifc", &cell, &[]);
+    let text = report.to_text();
+    assert_eq!(report.walls[0].framing.status, "Completed", "{text}");
+    assert_eq!(report.walls[0].nailing.status, "Completed", "{text}");
+    for p in &sim.records[0].placements {
+        assert!(
+            p.position_error <= 0.002,
+            "{} off by {} m",
+            p.piece,
+            p.position_error
+        );
+    }
+    assert_eq!(report.nailing_validation.checked, 8);
+    assert!(report.nailing_validation.max_error_mm < 1.0, "{text}");
 }
 
 #[test]

@@ -40,6 +40,8 @@ const NAIL_APPROACH: f64 = 0.10;
 /// above it instead, its nose this far off the face until the last stretch (m).
 const NAIL_DESCENT: f64 = 0.10;
 const NAIL_STANDOFF: f64 = 0.01;
+/// Where the nailer fires: its nose this far off the plate's face (m).
+const NOSE_GAP: f64 = 0.002;
 const GRIP_TIME: f64 = 0.5;
 const RELEASE_TIME: f64 = 0.3;
 const FIRE_TIME: f64 = 0.2;
@@ -798,6 +800,8 @@ impl<'a> WallRun<'a> {
         );
         self.end(id, "retract", start);
         if ok {
+            // Settled on the fixture: from now on the fixture holds it.
+            self.phys.clamp(id);
             self.placed.insert(id.to_string(), plan.target);
         }
     }
@@ -952,7 +956,9 @@ impl<'a> WallRun<'a> {
             let mut chosen: Option<(Isometry3<f64>, Isometry3<f64>, Vec<f64>)> = None;
             let mut miss: Option<(f64, IkFailure)> = None;
             let candidates = nail_rolls().into_iter().flat_map(|roll| {
-                let pose = nail_pose(&point, &direction, roll);
+                // The nose stops just short of the face: pressed against the work, the
+                // position-driven tool would shove the loose frame across the floor.
+                let pose = retreat(&nail_pose(&point, &direction, roll), NOSE_GAP);
                 nail_approaches(pose).map(move |back| (pose, back))
             });
             for (pose, back) in candidates {

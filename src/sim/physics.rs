@@ -456,6 +456,14 @@ impl Physics {
         }
     }
 
+    /// The fixture holds a placed piece where it came to rest (a framing table's stops and
+    /// clamps): it no longer moves, whatever touches it later.
+    pub fn clamp(&mut self, id: &str) {
+        if let Some(b) = self.lumber.get(id) {
+            self.world.bodies[b.body].set_body_type(RigidBodyType::Fixed, true);
+        }
+    }
+
     /// Moves a held piece with the tool by the end of the next step.
     pub fn carry(&mut self, id: &str, pose: &Isometry3<f64>) {
         if let Some(b) = self.lumber.get(id) {
