@@ -947,7 +947,10 @@ impl<'a> WallRun<'a> {
                     "",
                     0.0,
                     0.0,
-                    format!("{} was not placed", missing.join(" and ")),
+                    match missing.as_slice() {
+                        [one] => format!("{one} was not placed"),
+                        _ => format!("{} were not placed", missing.join(" and ")),
+                    },
                 );
                 continue;
             }
