@@ -2,8 +2,9 @@
 //! cache: `why` explains one element, so it simulates only that element's
 //! wall, and asking again about the same model, cell and rules costs no
 //! simulation. The cache key hashes everything the simulation depends on
-//! (model bytes, cell file, rule files, wall, framewright version); a stale
-//! or unreadable entry is simulated again, never trusted.
+//! (model bytes, the loaded cell with its robot and tool, rule files, wall,
+//! framewright version and the executor's source); a stale or unreadable
+//! entry is simulated again, never trusted.
 
 use crate::cell::Cell;
 use crate::frame::{Facts, RuleEngine};
@@ -107,17 +108,12 @@ fn cache_key(
     let mut h = Fnv::default();
     env!("CARGO_PKG_VERSION").hash(&mut h);
     bytes.hash(&mut h);
-    cell.name.hash(&mut h);
-    std::fs::read(&cell.source).unwrap_or_default().hash(&mut h);
-    // A cell's robot and tool come from their own files; their numbers are in the cell facts.
-    let cell_facts = crate::frame::cell_facts(cell);
-    for (name, tuples) in &cell_facts.tuples {
-        name.hash(&mut h);
-        for (t, _) in tuples {
-            for v in t {
-                v.to_string().hash(&mut h);
-            }
-        }
+    // The cell as loaded: layout, robot (links, collision shapes, limits) and tool, whichever
+    // files they came from.
+    format!("{cell:?}").hash(&mut h);
+    // The executor itself: a changed simulation must not be answered from an old entry.
+    for text in SIM_SOURCES {
+        text.hash(&mut h);
     }
     wall.hash(&mut h);
     match engine {
@@ -137,6 +133,17 @@ fn cache_key(
     }
     Ok(format!("{:016x}", h.finish()))
 }
+
+/// The executor's source, part of the cache key (the package version does not change between
+/// builds of a working copy).
+const SIM_SOURCES: [&str; 6] = [
+    include_str!("../sim/mod.rs"),
+    include_str!("../sim/executor.rs"),
+    include_str!("../sim/physics.rs"),
+    include_str!("../sim/motion.rs"),
+    include_str!("../sim/reach.rs"),
+    include_str!("../sim/record.rs"),
+];
 
 #[derive(Default)]
 struct Fnv(u64);
@@ -239,6 +246,21 @@ mod tests {
                 .collect();
             assert_eq!(&want, types, "{name}");
         }
+    }
+
+    #[test]
+    fn the_key_changes_with_the_robot_and_tool_geometry() {
+        let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm1.ifc");
+        let cell = Cell::load("study-abb").unwrap();
+        let key = |c: &Cell| cache_key(&model, c, "W1", &RuleEngine::Compiled).unwrap();
+        assert_eq!(key(&cell), key(&cell.clone()));
+        // A tool part moved 10 mm: no cell key or fact changes, the simulation does.
+        let mut moved = cell.clone();
+        moved.tool.parts[1].shape.origin.translation.x += 0.01;
+        assert_ne!(key(&cell), key(&moved));
+        let mut link = cell.clone();
+        link.robot.joints[2].origin.translation.z += 0.001;
+        assert_ne!(key(&cell), key(&link));
     }
 
     #[test]
