@@ -29,6 +29,8 @@ const TABLE_BORDER: f64 = 0.05;
 /// How far the arm, its tool and a held piece keep from everything on a move between poses
 /// (m): a kinematic arm grazing a piece on the belt knocks it over.
 const PATH_MARGIN: f64 = 0.005;
+/// Travel over which the margin grows from nothing at a move's ends to PATH_MARGIN (m).
+const MARGIN_TAPER: f64 = 0.05;
 /// Largest travel of any point of the arm between two checked samples of a move (m).
 const SWEEP_STEP: f64 = 0.02;
 /// A piece is released this far above its target and drops into place (m).
@@ -381,16 +383,26 @@ impl<'a> WallRun<'a> {
             .held
             .as_ref()
             .map(|h| (h.id.as_str(), &h.in_tool, h.half));
-        for leg in path.windows(2) {
-            let samples = (self.sweep_length(&leg[0], &leg[1]) / SWEEP_STEP)
-                .ceil()
-                .max(1.0) as usize;
+        let lengths: Vec<f64> = path
+            .windows(2)
+            .map(|leg| self.sweep_length(&leg[0], &leg[1]))
+            .collect();
+        let total: f64 = lengths.iter().sum();
+        let mut travelled = 0.0;
+        for (leg, length) in path.windows(2).zip(&lengths) {
+            let samples = (length / SWEEP_STEP).ceil().max(1.0) as usize;
             for k in 0..=samples {
-                let q = lerp(&leg[0], &leg[1], k as f64 / samples as f64);
-                if touches(&self.phys, self.cell, &q, held, ignore, PATH_MARGIN).is_some() {
+                let s = k as f64 / samples as f64;
+                // The margin grows from nothing at the two ends (poses already checked, which
+                // may lie close to what they work on) to PATH_MARGIN after MARGIN_TAPER.
+                let from_end = (travelled + s * length).min(total - travelled - s * length);
+                let margin = PATH_MARGIN * (from_end / MARGIN_TAPER).clamp(0.0, 1.0);
+                let q = lerp(&leg[0], &leg[1], s);
+                if touches(&self.phys, self.cell, &q, held, ignore, margin).is_some() {
                     return false;
                 }
             }
+            travelled += length;
         }
         true
     }
