@@ -39,8 +39,9 @@ const RELEASE_GAP: f64 = 0.001;
 const NAIL_APPROACH: f64 = 0.10;
 /// Where the straight line back along the nail is out of reach (a nail driven towards the
 /// robot at the far edge of its reach), the nailer comes down to the nail from this far
-/// above it instead, its nose this far off the face until the last stretch (m).
+/// above it instead (m)...
 const NAIL_DESCENT: f64 = 0.10;
+/// ...its nose this far off the face until the last stretch (m).
 const NAIL_STANDOFF: f64 = 0.01;
 /// Where the nailer fires: its nose this far off the plate's face (m).
 const NOSE_GAP: f64 = 0.002;
@@ -376,8 +377,9 @@ impl<'a> WallRun<'a> {
     }
 
     /// Whether the arm sweeps along `path` (straight in joint space between waypoints) at
-    /// least PATH_MARGIN clear of everything: checked at samples no further apart than
-    /// SWEEP_STEP for the fastest-moving point of the arm, its tool and a held piece.
+    /// least PATH_MARGIN clear of everything away from its two ends: checked at samples no
+    /// further apart than SWEEP_STEP for the fastest-moving point of the arm, its tool and a
+    /// held piece.
     fn path_clear(&self, path: &[Vec<f64>], ignore: &[&str]) -> bool {
         let held = self
             .held
