@@ -518,8 +518,8 @@ impl Physics {
     }
 
     /// Contacts of the robot, its tool and the piece `held` with anything else, deeper than
-    /// `tolerance` (any depth between the arm or tool and lumber): (body, other body, depth), excluding the held
-    /// piece against the tool.
+    /// `tolerance` (any depth between the arm or tool and lumber): (body, other body, depth),
+    /// excluding the held piece against the tool.
     pub fn robot_contacts(&self, held: Option<&str>, tolerance: f64) -> Vec<(String, String, f64)> {
         let held_collider = held.and_then(|id| self.lumber.get(id)).map(|b| b.collider);
         let mut found = Vec::new();
