@@ -33,6 +33,24 @@ fn json(report: &SimReport) -> String {
     String::from_utf8(out).unwrap()
 }
 
+/// Every placed piece of the first simulated wall within 2 mm and 1° of its target.
+fn assert_placed_within_2_mm_and_1_degree(sim: &Simulation, context: &str) {
+    for p in &sim.records[0].placements {
+        assert!(
+            p.position_error <= 0.002,
+            "{context}: {} off by {} m",
+            p.piece,
+            p.position_error
+        );
+        assert!(
+            p.angle_error <= 1f64.to_radians(),
+            "{context}: {} turned {} rad",
+            p.piece,
+            p.angle_error
+        );
+    }
+}
+
 #[test]
 fn tm2_frames_and_nails_every_piece_within_2_mm_and_1_degree() {
     let (sim, report) = run("tm2.ifc", "study-abb", &[]);
@@ -46,20 +64,7 @@ fn tm2_frames_and_nails_every_piece_within_2_mm_and_1_degree() {
     assert_eq!(report.walls[0].material_feeding, "Completed");
     let placements = &sim.records[0].placements;
     assert_eq!(placements.len(), 4, "every piece placed");
-    for p in placements {
-        assert!(
-            p.position_error <= 0.002,
-            "{} off by {} m",
-            p.piece,
-            p.position_error
-        );
-        assert!(
-            p.angle_error <= 1f64.to_radians(),
-            "{} turned {} rad",
-            p.piece,
-            p.angle_error
-        );
-    }
+    assert_placed_within_2_mm_and_1_degree(&sim, "tm2");
     // Every driven nail is checked against the as-built pieces.
     let v = &report.nailing_validation;
     assert_eq!(v.planned, 8);
@@ -198,14 +203,7 @@ fn the_arm_does_not_knock_lumber_off_the_belt_on_its_way_to_a_pick() {
         assert_eq!(e.framing.status, "framed", "{text}");
     }
     assert!(!report.walls[0].framing.failed_component.contains("Gripper"));
-    for p in &sim.records[0].placements {
-        assert!(
-            p.position_error <= 0.002,
-            "{} off by {} m",
-            p.piece,
-            p.position_error
-        );
-    }
+    assert_placed_within_2_mm_and_1_degree(&sim, "tm2 on study-kuka");
 }
 
 /// The shipped cell with one line of its file replaced (the line starting with `key = `).
@@ -264,16 +262,8 @@ fn tm1_completes_on_both_robots_when_the_wall_lies_on_a_framing_table() {
         assert!(report.contacts.is_empty(), "{cell}: {text}");
         let placements = &sim.records[0].placements;
         assert_eq!(placements.len(), 4);
-        for p in placements {
-            assert!(
-                p.position_error <= 0.002,
-                "{cell}: {} off by {} m",
-                p.piece,
-                p.position_error
-            );
-            // Within 2 mm of a target on the table top: the table holds the wall up.
-            assert!(p.angle_error <= 1f64.to_radians());
-        }
+        // Within 2 mm of targets on the table top: the table holds the wall up.
+        assert_placed_within_2_mm_and_1_degree(&sim, cell);
         assert_eq!(report.nailing_validation.checked, 8);
         assert!(report.nailing_validation.max_error_mm < 2.0);
     }
@@ -290,14 +280,7 @@ fn nailing_does_not_shift_the_placed_frame() {
     let text = report.to_text();
     assert_eq!(report.walls[0].framing.status, "Completed", "{text}");
     assert_eq!(report.walls[0].nailing.status, "Completed", "{text}");
-    for p in &sim.records[0].placements {
-        assert!(
-            p.position_error <= 0.002,
-            "{} off by {} m",
-            p.piece,
-            p.position_error
-        );
-    }
+    assert_placed_within_2_mm_and_1_degree(&sim, "study-abb at 0.80 m");
     assert_eq!(report.nailing_validation.checked, 8);
     assert!(report.nailing_validation.max_error_mm < 1.0, "{text}");
 }
