@@ -871,6 +871,10 @@ impl<'a> WallRun<'a> {
                     continue;
                 }
                 let attempt = (|| {
+                    // The pick and place poses themselves first: when one is out of the arm's
+                    // range, that (not its approach above) is the miss to report.
+                    solve(self.cell, &pick, &grip, &self.q).map_err(|f| ("pick", f))?;
+                    solve(self.cell, &place, &grip, &self.q).map_err(|f| ("place", f))?;
                     let q_above_pick = solve(self.cell, &raise(&pick, CLEARANCE), &grip, &self.q)
                         .map_err(|f| ("pick", f))?;
                     let q_pick = line(
