@@ -271,3 +271,34 @@ fn simulate_gives_rules_the_executor_facts() {
     let out = run(&["check", s(&model), "--rules", s(&f)]);
     assert_eq!(out.status.code(), Some(0));
 }
+
+#[test]
+fn plan_and_check_refuse_an_absurd_contact_tolerance() {
+    let model = path("examples/models/tm1.ifc");
+    let rules = path("examples/rules/gripper_spacing.dl");
+    for args in [
+        vec!["plan", s(&model), "--contact-tolerance=-1"],
+        vec!["plan", s(&model), "--contact-tolerance=NaN"],
+        vec![
+            "check",
+            s(&model),
+            "--rules",
+            s(&rules),
+            "--contact-tolerance=500",
+        ],
+    ] {
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--contact-tolerance") && err.contains("give 0 to 100 mm"),
+            "{err}"
+        );
+        assert!(out.stdout.is_empty());
+    }
+    assert!(
+        run(&["plan", s(&model), "--contact-tolerance=2"])
+            .status
+            .success()
+    );
+}

@@ -1,13 +1,10 @@
 //! `framewright plan MODEL.ifc [--cell C] [--json]`: walls, roles, assembly
 //! order, nailing and framing targets.
 
+use super::check::{load_inputs, rule_base};
 use super::{CmdResult, print_stdout, write_stdout};
-use framewright::cell::Cell;
-use framewright::frame::cell_facts::cell_facts;
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, model_facts, reason};
-use framewright::geom::ContactOptions;
-use framewright::ifc::Model;
+use framewright::frame::reason;
 use framewright::report::plan::PlanReport;
 use std::path::PathBuf;
 
@@ -30,18 +27,8 @@ pub struct PlanArgs {
 }
 
 pub fn run(args: PlanArgs) -> CmdResult {
-    let model = Model::open(&args.model)?;
-    let cell = Cell::load(&args.cell)?;
-    let contacts = ContactOptions {
-        tolerance: args.contact_tolerance / 1000.0,
-        ..ContactOptions::default()
-    };
-    let mut facts = model_facts(&model, &contacts);
-    facts.extend(cell_facts(&cell));
-    let engine = args
-        .rules_dir
-        .map_or(RuleEngine::Compiled, RuleEngine::Directory);
-    let reasoned = reason(&facts, &engine, false)?;
+    let (model, _, facts) = load_inputs(&args.model, &args.cell, args.contact_tolerance)?;
+    let reasoned = reason(&facts, &rule_base(&args.rules_dir), false)?;
     let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
     if args.json {
         write_stdout(|out| report.write_json(&mut &mut *out))
