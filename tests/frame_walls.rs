@@ -1,6 +1,8 @@
 //! Wall grouping and wall frames against the truth of every model: the
 //! partition of pieces into walls and each wall's frame matrix and size.
 
+mod common;
+
 use framewright::frame::plan::Plan;
 use framewright::frame::{RuleEngine, model_facts, reason};
 use framewright::ifc::Model;
@@ -11,12 +13,7 @@ use std::path::{Path, PathBuf};
 fn truth_files() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut dirs = vec![root.join("examples/models"), root.join("tests/fixtures")];
-    let shared = root.join("../shared/ifc-testcases");
-    if shared.is_dir() {
-        dirs.push(shared);
-    } else {
-        eprintln!("skipped the shared models: {} is absent", shared.display());
-    }
+    dirs.extend(common::shared_path("ifc-testcases"));
     let mut files = Vec::new();
     for dir in dirs {
         for e in std::fs::read_dir(dir).unwrap() {
@@ -118,12 +115,11 @@ fn walls_and_frames_match_the_truth() {
 
 #[test]
 fn no_framing_means_no_walls_and_a_reason() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/ifc-realworld/timber_archicad20_FZK-Haus-roof-rafters_IFC4.ifc");
-    if !path.is_file() {
-        eprintln!("skipped: {} is absent", path.display());
+    let Some(path) =
+        common::shared_path("ifc-realworld/timber_archicad20_FZK-Haus-roof-rafters_IFC4.ifc")
+    else {
         return;
-    }
+    };
     let model = Model::open(&path).unwrap();
     let reasoned = reason(
         &model_facts(&model, &Default::default()),

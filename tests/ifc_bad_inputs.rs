@@ -2,6 +2,8 @@
 //! entity or line, or exit 0 with a warning naming the skipped member. Never
 //! a panic or a hang.
 
+mod common;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -35,11 +37,10 @@ fn run(path: &Path) -> (i32, String, String) {
 }
 
 fn shared_bad_inputs() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/ifc-testcases");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipped: {} is absent", dir.display());
+    let Some(dir) = common::shared_path("ifc-testcases") else {
         return Vec::new();
     };
+    let entries = std::fs::read_dir(&dir).unwrap();
     let mut files: Vec<PathBuf> = entries
         .map(|e| e.unwrap().path())
         .filter(|p| {

@@ -1,19 +1,13 @@
 //! Files written by real authoring tools load with their pieces and honest
 //! warnings.
 
+mod common;
+
 use framewright::ifc::Model;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn realworld(name: &str) -> Option<PathBuf> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/ifc-realworld")
-        .join(name);
-    if path.is_file() {
-        Some(path)
-    } else {
-        eprintln!("skipped: {} is absent", path.display());
-        None
-    }
+    common::shared_path(&format!("ifc-realworld/{name}"))
 }
 
 const INCH: f64 = 0.0254;
@@ -21,11 +15,10 @@ const FOOT: f64 = 0.3048;
 
 #[test]
 fn every_file_loads() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/ifc-realworld");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipped: {} is absent", dir.display());
+    let Some(dir) = common::shared_path("ifc-realworld") else {
         return;
     };
+    let entries = std::fs::read_dir(&dir).unwrap();
     let mut files: Vec<PathBuf> = entries
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|x| x == "ifc"))

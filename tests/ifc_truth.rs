@@ -1,6 +1,8 @@
 //! Every member of every shared truth model is read within 0.5 mm:
 //! axis end points (as an unordered pair), width, thickness and length.
 
+mod common;
+
 use framewright::ifc::Model;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -8,13 +10,7 @@ use std::path::{Path, PathBuf};
 const TOLERANCE: f64 = 0.0005;
 
 fn testcases() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/ifc-testcases");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipped: {} is absent", dir.display());
-        None
-    }
+    common::shared_path("ifc-testcases")
 }
 
 fn point(v: &Value) -> [f64; 3] {

@@ -1,18 +1,14 @@
 //! FK of the shipped robots against the reference matrices in ../shared/robot-reference/README.md
 //! and against the reference URDFs there.
 
+mod common;
+
 use framewright::cell::{Robot, RobotMeta, matrix_rows};
 use std::f64::consts::FRAC_PI_2;
 use std::path::{Path, PathBuf};
 
 fn shared() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/robot-reference");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skip: {} not found", dir.display());
-        None
-    }
+    common::shared_path("robot-reference")
 }
 
 struct Reference {

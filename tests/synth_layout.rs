@@ -1,5 +1,7 @@
 //! Layouts: counts, dimensions, opening framing, validation, and agreement with
 //! the study's geometry facts recorded in the shared truth files.
+
+mod common;
 use framewright::synth::building::grid;
 use framewright::synth::layout::{Layout, Role, Vec3};
 use framewright::synth::models;
@@ -9,7 +11,6 @@ use framewright::synth::wall::{
 };
 use framewright::synth::{SynthError, WriteOptions, write_ifc};
 use std::collections::BTreeMap;
-use std::path::Path;
 
 const EPS: f64 = 1e-9;
 
@@ -94,13 +95,10 @@ fn tm3_has_62_members_in_4_walls_16in_on_centre() {
 
 /// Compare one model's truth with the shared truth file (absent: skip).
 fn same_as_shared(layout: &Layout, shared_name: &str) {
-    let shared = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/ifc-testcases")
-        .join(shared_name);
-    let Ok(text) = std::fs::read_to_string(&shared) else {
-        eprintln!("skip: {} not found", shared.display());
+    let Some(shared) = common::shared_path(&format!("ifc-testcases/{shared_name}")) else {
         return;
     };
+    let text = std::fs::read_to_string(&shared).unwrap();
     let theirs: serde_json::Value = serde_json::from_str(&text).unwrap();
     let ours = write_ifc(layout, &WriteOptions::default()).unwrap().truth;
     let ours: serde_json::Value = serde_json::to_value(&ours).unwrap();

@@ -1,6 +1,8 @@
 //! The simulation world (`rules/world.dl`, `world::Scene`): spawn order and spacing on
 //! conveyor 1, pose on the belt, masses, and determinism of the JSON scene.
 
+mod common;
+
 use framewright::cell::Cell;
 use framewright::frame::RuleEngine;
 use framewright::frame::facts::density_of;
@@ -288,11 +290,9 @@ fn engines_agree_on_the_scene() {
 /// spawns once, in slots 0..n.
 #[test]
 fn shared_test_cases_build_scenes() {
-    let dir = root().join("../shared/ifc-testcases");
-    if !dir.is_dir() {
-        eprintln!("skipped: {} is absent", dir.display());
+    let Some(dir) = common::shared_path("ifc-testcases") else {
         return;
-    }
+    };
     let cell = Cell::load("study-abb").unwrap();
     for name in [
         "a_paper_tm1.ifc",
@@ -347,11 +347,9 @@ fn pieces_longer_than_the_belt_are_warned_about() {
 /// when absent); studs and plates lie on edge.
 #[test]
 fn headers_lie_flat_at_their_targets() {
-    let path = root().join("../shared/ifc-testcases/d_wall_door.ifc");
-    if !path.is_file() {
-        eprintln!("skipped: {} is absent", path.display());
+    let Some(path) = common::shared_path("ifc-testcases/d_wall_door.ifc") else {
         return;
-    }
+    };
     let cell = Cell::load("study-abb").unwrap();
     let s = Scene::from_model_file(&path, &cell).unwrap();
     let flat: Vec<&ScenePiece> = s.pieces.iter().filter(|p| !p.on_edge).collect();
