@@ -22,24 +22,31 @@ pub struct CheckArgs {
     /// A user rule file deriving violation(id, rule, message) or warning(...). Repeatable.
     #[arg(long = "rules", value_name = "FILE.dl", required = true)]
     pub rules: Vec<PathBuf>,
-    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
-    #[arg(long, default_value = "study-abb")]
-    pub cell: String,
+    #[command(flatten)]
+    pub inputs: ReasoningInputs,
     /// Print JSON instead of one line per finding.
     #[arg(long)]
     pub json: bool,
-    /// Replace the built-in rule base with every .dl file of this directory.
-    #[arg(long, value_name = "DIR")]
-    pub rules_dir: Option<PathBuf>,
-    /// Largest gap between two pieces still taken as touching, millimetres.
-    #[arg(long, value_name = "MM", default_value_t = 3.0)]
-    pub contact_tolerance: f64,
     /// Simulate the walls first, so rules can read the executor's facts (sim_*) and verdicts.
     #[arg(long)]
     pub simulate: bool,
     /// With --simulate: only this wall (id or name); repeat for more.
     #[arg(long = "wall", value_name = "W", requires = "simulate")]
     pub walls: Vec<String>,
+}
+
+/// The options every command that reasons a model shares (plan, check, why).
+#[derive(clap::Args)]
+pub struct ReasoningInputs {
+    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    #[arg(long, default_value = "study-abb")]
+    pub cell: String,
+    /// Replace the built-in rule base with every .dl file of this directory.
+    #[arg(long, value_name = "DIR")]
+    pub rules_dir: Option<PathBuf>,
+    /// Largest gap between two pieces still taken as touching, millimetres.
+    #[arg(long, value_name = "MM", default_value_t = 3.0)]
+    pub contact_tolerance: f64,
 }
 
 /// The model, the cell and their facts (what plan, check and why start from).
@@ -90,18 +97,18 @@ struct Row<'a> {
 }
 
 pub fn run(args: CheckArgs) -> CmdResult {
-    let base = rule_base(&args.rules_dir);
+    let base = rule_base(&args.inputs.rules_dir);
     // Rule files first: a typo fails before the model is read.
     let user = UserRules::load(&args.rules, &base)?;
     if args.simulate {
-        if args.contact_tolerance != 3.0 {
+        if args.inputs.contact_tolerance != 3.0 {
             return Err(Failure::bad_input(
                 "--contact-tolerance cannot be combined with --simulate (the executor plans with the default tolerance)",
             ));
         }
         // The executor reads the model and reasons itself.
         let model = Model::open(&args.model)?;
-        let cell = Cell::load(&args.cell)?;
+        let cell = Cell::load(&args.inputs.cell)?;
         let options = SimOptions {
             walls: args.walls.clone(),
             engine: base.clone(),
@@ -111,7 +118,11 @@ pub fn run(args: CheckArgs) -> CmdResult {
         let findings = user.evaluate(&sim.reasoned.relations)?;
         return report(&args, &model, &cell.name, &findings);
     }
-    let (model, cell, facts) = load_inputs(&args.model, &args.cell, args.contact_tolerance)?;
+    let (model, cell, facts) = load_inputs(
+        &args.model,
+        &args.inputs.cell,
+        args.inputs.contact_tolerance,
+    )?;
     let reasoned = reason(&facts, &base, false)?;
     let findings = user.evaluate(&reasoned.relations)?;
     report(&args, &model, &cell.name, &findings)

@@ -3,7 +3,7 @@
 //! keys and rule lines; or which rule could have derived a tuple and which
 //! condition failed.
 
-use super::check::{load_inputs, rule_base};
+use super::check::{ReasoningInputs, load_inputs, rule_base};
 use super::{CmdResult, Failure, print_stdout};
 use framewright::user_rules::render::{render_why, render_why_not};
 use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
@@ -33,21 +33,14 @@ pub struct WhyNotArgs {
 
 #[derive(clap::Args)]
 pub struct Common {
-    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
-    #[arg(long, default_value = "study-abb")]
-    pub cell: String,
+    #[command(flatten)]
+    pub inputs: ReasoningInputs,
     /// Print the complete trees as JSON.
     #[arg(long)]
     pub json: bool,
     /// User rule files whose findings are explained too. Repeatable.
     #[arg(long = "rules", value_name = "FILE.dl")]
     pub rules: Vec<PathBuf>,
-    /// Replace the built-in rule base with every .dl file of this directory.
-    #[arg(long, value_name = "DIR")]
-    pub rules_dir: Option<PathBuf>,
-    /// Largest gap between two pieces still taken as touching, millimetres.
-    #[arg(long, value_name = "MM", default_value_t = 3.0)]
-    pub contact_tolerance: f64,
     /// Explain the plan only: do not simulate the element's wall.
     #[arg(long)]
     pub no_simulate: bool,
@@ -76,7 +69,7 @@ fn simulate_walls(
     if c.no_simulate {
         return Ok(Vec::new());
     }
-    let base = rule_base(&c.rules_dir);
+    let base = rule_base(&c.inputs.rules_dir);
     let ctx = Context {
         model,
         facts,
@@ -127,8 +120,9 @@ fn failure(e: WhyError) -> Failure {
 
 pub fn run_why(args: WhyArgs) -> CmdResult {
     let c = &args.common;
-    let base = rule_base(&c.rules_dir);
-    let (model, cell, mut facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let base = rule_base(&c.inputs.rules_dir);
+    let (model, cell, mut facts) =
+        load_inputs(&args.model, &c.inputs.cell, c.inputs.contact_tolerance)?;
     let simulated = simulate_walls(
         c,
         &args.model,
@@ -183,8 +177,9 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
 
 pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     let c = &args.common;
-    let base = rule_base(&c.rules_dir);
-    let (model, cell, mut facts) = load_inputs(&args.model, &c.cell, c.contact_tolerance)?;
+    let base = rule_base(&c.inputs.rules_dir);
+    let (model, cell, mut facts) =
+        load_inputs(&args.model, &c.inputs.cell, c.inputs.contact_tolerance)?;
     let ids = piece_ids_in(&model, &args.tuple);
     simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
     let ctx = Context {
