@@ -138,7 +138,7 @@ fn cache_key(
 /// builds of a working copy).
 const SIM_SOURCES: [&str; 6] = [
     include_str!("../sim/mod.rs"),
-    include_str!("../sim/executor.rs"),
+    include_str!("../sim/executor/mod.rs"),
     include_str!("../sim/physics.rs"),
     include_str!("../sim/motion.rs"),
     include_str!("../sim/reach.rs"),

@@ -1,0 +1,408 @@
+//! Framing: grip a piece at the sensor, carry it above its framing target, place and release it.
+
+use super::paths::distance;
+use super::{Held, LINE_ACCEL, LINE_SPEED, WallRun, failure_score, raise};
+use crate::cell::IkFailure;
+use crate::sim::motion::LinearMove;
+use crate::sim::reach::{line, reach_margin, solve, touches};
+use crate::sim::record::IkRecord;
+use crate::world::ScenePiece;
+use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
+
+/// Height above the pick and place poses the gripper approaches from (m).
+pub(super) const CLEARANCE: f64 = 0.25;
+/// A piece is released this far above its target and drops into place (m).
+pub(super) const RELEASE_GAP: f64 = 0.001;
+pub(super) const GRIP_TIME: f64 = 0.5;
+pub(super) const RELEASE_TIME: f64 = 0.3;
+/// A piece more than this far from where the plan expected it when the jaws close is not
+/// held (m).
+pub(super) const GRIP_TOLERANCE: f64 = 0.005;
+/// A piece that ran into the sensor's end stop settles this long before the robot plans its
+/// grip (s).
+pub(super) const SENSOR_SETTLE: f64 = 0.5;
+/// The longest the executor waits for a piece at the sensor to come to rest (s).
+pub(super) const MAX_SENSOR_SETTLE: f64 = 3.0;
+
+/// A planned framing: the grip and the joint values of its four poses.
+struct FramingPlan {
+    pick: Isometry3<f64>,
+    place: Isometry3<f64>,
+    q_above_pick: Vec<f64>,
+    q_above_place: Vec<f64>,
+    pick_margin: f64,
+    place_margin: f64,
+    /// The piece's body pose the pick was planned on.
+    pick_body: Isometry3<f64>,
+    /// The target orientation actually used (a box has four equivalent ones).
+    target: Isometry3<f64>,
+}
+
+impl<'a> WallRun<'a> {
+    pub(super) fn frame(&mut self, piece: &'a ScenePiece) {
+        let start = self.begin(&piece.id, "feed", &[]);
+        let fed = self.await_piece(piece);
+        self.end(&piece.id, "feed", start);
+        if let Err(why) = fed {
+            self.record.not_fed.push((piece.id.clone(), why));
+            self.take_off(&piece.id);
+            return;
+        }
+        self.record.fed.push((piece.id.clone(), self.t));
+        // Let the piece come to rest against the end stop before planning the grip.
+        self.wait(SENSOR_SETTLE);
+        let mut waited = SENSOR_SETTLE;
+        while waited < MAX_SENSOR_SETTLE
+            && self
+                .phys
+                .lumber_speed(&piece.id)
+                .is_some_and(|(v, w)| v > 1e-3 || w > 1e-2)
+        {
+            self.wait(0.1);
+            waited += 0.1;
+        }
+        if let Some(pose) = self.phys.lumber_pose(&piece.id)
+            && piece.on_edge
+            && (pose.rotation * Vector3::y()).z.abs() < 0.9
+        {
+            self.record.grip_failed.push((
+                piece.id.clone(),
+                "it toppled over at the end stop of conveyor 2 (it lies on its wide face); the gripper takes lumber standing on edge".into(),
+            ));
+            self.take_off(&piece.id);
+            return;
+        }
+        if let Err(why) = self.grip_check(piece) {
+            self.record.grip_failed.push((piece.id.clone(), why));
+            self.take_off(&piece.id);
+            return;
+        }
+        let plan = match self.plan_framing(piece) {
+            Ok(plan) => plan,
+            Err((op, failure)) => {
+                self.record.ik.push(IkRecord {
+                    piece: piece.id.clone(),
+                    op,
+                    result: Err(failure),
+                });
+                self.take_off(&piece.id);
+                return;
+            }
+        };
+        for (op, margin) in [("pick", plan.pick_margin), ("place", plan.place_margin)] {
+            self.record.ik.push(IkRecord {
+                piece: piece.id.clone(),
+                op,
+                result: Ok(margin),
+            });
+        }
+        let grip = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
+        let id = piece.id.as_str();
+
+        // Pick: approach above, descend, close the jaws, lift.
+        let start = self.begin(id, "pick", &[]);
+        // The approach must not touch the piece either; the descent and grip may.
+        if let Some(current) = &mut self.current {
+            current.2.clear();
+        }
+        self.move_to(&plan.q_above_pick.clone(), &grip, &[]);
+        if let Some(current) = &mut self.current {
+            current.2.push(format!("piece {id}"));
+        }
+        let above_pick = raise(&plan.pick, CLEARANCE);
+        let ok = self
+            .run_line(
+                &LinearMove::new(above_pick, plan.pick, LINE_SPEED, LINE_ACCEL),
+                &grip,
+            )
+            .is_ok();
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
+        let body = self.phys.lumber_pose(id).unwrap_or(piece.spawn);
+        // The jaws close where the plan expected the piece; if it is not there (it moved after
+        // the plan), the grip fails.
+        let expected = plan.pick * grip.inverse();
+        let offset = (body.translation.vector
+            - (tool * expected.inverse() * plan.pick_body)
+                .translation
+                .vector)
+            .norm();
+        if ok && offset > GRIP_TOLERANCE {
+            self.phys.set_jaws(None);
+            let _ = self.run_line(
+                &LinearMove::new(
+                    plan.pick,
+                    raise(&plan.pick, CLEARANCE),
+                    LINE_SPEED,
+                    LINE_ACCEL,
+                ),
+                &grip,
+            );
+            self.end(id, "pick", start);
+            self.record.grip_failed.push((
+                id.to_string(),
+                format!(
+                    "the piece was {:.0} mm from where the jaws closed on it",
+                    offset * 1000.0
+                ),
+            ));
+            self.take_off(id);
+            return;
+        }
+        // Hold the piece where it lies, then close the jaws on it: finger plates jumping shut
+        // on a free piece would knock it over.
+        self.phys.attach(id);
+        self.phys.set_jaws(Some(piece.size[2]));
+        self.wait(GRIP_TIME);
+        self.held = Some(Held {
+            id: id.to_string(),
+            in_tool: tool.inverse() * body,
+            half: piece.size.map(|v| v / 2.0),
+        });
+        let ok = ok
+            && self
+                .run_line(
+                    &LinearMove::new(plan.pick, above_pick, LINE_SPEED, LINE_ACCEL),
+                    &grip,
+                )
+                .is_ok();
+        self.on_belts.remove(id);
+        self.start_belts(id);
+        self.end(id, "pick", start);
+
+        // The place pose from how the piece actually sits in the gripper.
+        let (place, q_above_place) = match &self.held {
+            Some(h) => {
+                let place = plan.target * h.in_tool.inverse() * grip;
+                match solve(
+                    self.cell,
+                    &raise(&place, CLEARANCE),
+                    &grip,
+                    &plan.q_above_place,
+                ) {
+                    Ok(q) => (place, q),
+                    Err(_) => (plan.place, plan.q_above_place.clone()),
+                }
+            }
+            None => (plan.place, plan.q_above_place.clone()),
+        };
+
+        // Move above the target.
+        let start = self.begin(id, "move", &[]);
+        if ok {
+            self.move_to(&q_above_place, &grip, &[]);
+        }
+        self.end(id, "move", start);
+
+        // Place: descend, open, release, retract.
+        let start = self.begin(id, "place", &[]);
+        let above_place = raise(&place, CLEARANCE);
+        let release = raise(&place, RELEASE_GAP);
+        let ok = ok
+            && self
+                .run_line(
+                    &LinearMove::new(above_place, release, LINE_SPEED, LINE_ACCEL),
+                    &grip,
+                )
+                .is_ok();
+        self.phys.set_jaws(None);
+        self.phys.detach(id);
+        self.held = None;
+        self.wait(RELEASE_TIME);
+        self.end(id, "place", start);
+        let start = self.begin(id, "retract", &[]);
+        let _ = self.run_line(
+            &LinearMove::new(release, above_place, LINE_SPEED, LINE_ACCEL),
+            &grip,
+        );
+        self.end(id, "retract", start);
+        if ok {
+            // Settled on the fixture: from now on the fixture holds it.
+            self.phys.clamp(id);
+            self.placed.insert(id.to_string(), plan.target);
+        }
+    }
+
+    /// Whether the gripper can take the piece: jaws across its thickness, both grippers on it.
+    fn grip_check(&self, piece: &ScenePiece) -> Result<(), String> {
+        let Some(g) = &self.cell.tool.gripper else {
+            return Err(format!("the tool {} has no gripper", self.cell.tool.name));
+        };
+        let [length, _, thickness] = piece.size;
+        if thickness > g.open_width || thickness < g.closed_width {
+            return Err(format!(
+                "its thickness {:.0} mm is outside the jaws' range {:.0}..{:.0} mm",
+                thickness * 1000.0,
+                g.closed_width * 1000.0,
+                g.open_width * 1000.0
+            ));
+        }
+        if length < g.spacing {
+            return Err(format!(
+                "it is {:.0} mm long, shorter than the gripper spacing {:.0} mm: only one gripper would hold it",
+                length * 1000.0,
+                g.spacing * 1000.0
+            ));
+        }
+        Ok(())
+    }
+
+    /// Chooses the grip (which way round the tool holds the piece) and the target orientation
+    /// (a box fits its target four ways) whose pick and place poses the arm reaches, preferring
+    /// a tool pointing down, poses clear of other bodies and short joint travel. Err: the
+    /// operation and failure of the closest miss.
+    fn plan_framing(&self, piece: &ScenePiece) -> Result<FramingPlan, (&'static str, IkFailure)> {
+        let grip = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
+        let body = self.phys.lumber_pose(&piece.id).unwrap_or(piece.spawn);
+        let along = self.cell.conveyor2.direction();
+        let mut best: Option<(f64, FramingPlan)> = None;
+        let mut miss: Option<(f64, &'static str, IkFailure)> = None;
+        let mut note_miss = |op, f: IkFailure| {
+            let score = failure_score(&f);
+            if miss.as_ref().is_none_or(|m| score < m.0) {
+                miss = Some((score, op, f));
+            }
+        };
+        for flip in [false, true] {
+            let pick = grip_pose(&body, piece, &along, self.cell.pick.offset, flip);
+            let in_body = body.inverse() * pick;
+            for symmetry in box_symmetries() {
+                let target = piece.target_cell * symmetry;
+                let place = target * in_body;
+                let down = -(place.rotation * Vector3::z()).z;
+                if down < 0.5 && piece.on_edge {
+                    continue;
+                }
+                let attempt = (|| {
+                    // The pick and place poses themselves first: when one is out of the arm's
+                    // range, that (not its approach above) is the miss to report.
+                    solve(self.cell, &pick, &grip, &self.q).map_err(|f| ("pick", f))?;
+                    solve(self.cell, &place, &grip, &self.q).map_err(|f| ("place", f))?;
+                    let q_above_pick = solve(self.cell, &raise(&pick, CLEARANCE), &grip, &self.q)
+                        .map_err(|f| ("pick", f))?;
+                    let q_pick = line(
+                        self.cell,
+                        &q_above_pick,
+                        &raise(&pick, CLEARANCE),
+                        &pick,
+                        &grip,
+                        5,
+                    )
+                    .map_err(|f| ("pick", f))?;
+                    let q_above_place =
+                        solve(self.cell, &raise(&place, CLEARANCE), &grip, &q_above_pick)
+                            .map_err(|f| ("place", f))?;
+                    let q_place = line(
+                        self.cell,
+                        &q_above_place,
+                        &raise(&place, CLEARANCE),
+                        &place,
+                        &grip,
+                        5,
+                    )
+                    .map_err(|f| ("place", f))?;
+                    Ok::<_, (&'static str, IkFailure)>((
+                        q_above_pick,
+                        q_pick,
+                        q_above_place,
+                        q_place,
+                    ))
+                })();
+                match attempt {
+                    Err((op, f)) => note_miss(op, f),
+                    Ok((q_above_pick, q_pick, q_above_place, q_place)) => {
+                        let held_in_tool = grip * in_body.inverse();
+                        let half = piece.size.map(|v| v / 2.0);
+                        let held = Some((piece.id.as_str(), &held_in_tool, half));
+                        let blocked = touches(&self.phys, self.cell, &q_place, held, &[], 0.0)
+                            .or_else(|| {
+                                touches(&self.phys, self.cell, &q_pick, None, &[&piece.id], 0.0)
+                            });
+                        if let Some((a, b)) = blocked {
+                            // A reachable pose that collides: the closest kind of miss.
+                            note_miss("place", IkFailure::AllSolutionsCollide { pair: [a, b] });
+                            continue;
+                        }
+                        let travel = distance(&self.q, &q_above_pick)
+                            + distance(&q_above_pick, &q_above_place);
+                        let score = (1.0 - down) * 100.0 + travel;
+                        if best.as_ref().is_none_or(|b| score < b.0) {
+                            best = Some((
+                                score,
+                                FramingPlan {
+                                    pick_body: body,
+                                    pick_margin: reach_margin(self.cell, &pick, &grip),
+                                    place_margin: reach_margin(self.cell, &place, &grip),
+                                    pick,
+                                    place,
+                                    q_above_pick,
+                                    q_above_place,
+                                    target,
+                                },
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        match (best, miss) {
+            (Some((_, plan)), _) => Ok(plan),
+            (None, Some((_, op, f))) => Err((op, f)),
+            (None, None) => Err(("place", IkFailure::InvalidPose)),
+        }
+    }
+}
+
+/// The grip TCP on a piece lying on conveyor 2: on its top face, `offset` back from its
+/// leading end (or at its middle if it is shorter), z down, y along the piece (reversed when
+/// `flip`), x across it (the jaws close along x).
+fn grip_pose(
+    body: &Isometry3<f64>,
+    piece: &ScenePiece,
+    along_belt: &Vector3<f64>,
+    offset: f64,
+    flip: bool,
+) -> Isometry3<f64> {
+    let axes: [Vector3<f64>; 3] = std::array::from_fn(|i| body.rotation * Vector3::ith(i, 1.0));
+    let long = if axes[0].dot(along_belt) >= 0.0 {
+        axes[0]
+    } else {
+        -axes[0]
+    };
+    // The up axis: whichever of the section's axes is closest to vertical.
+    let (up_axis, height) = if axes[1].z.abs() >= axes[2].z.abs() {
+        (axes[1], piece.size[1])
+    } else {
+        (axes[2], piece.size[2])
+    };
+    let up = if up_axis.z >= 0.0 { up_axis } else { -up_axis };
+    let length = piece.size[0];
+    let from_centre = (length / 2.0 - offset).max(0.0);
+    let point = body.translation.vector + long * from_centre + up * (height / 2.0);
+    let z = -up;
+    let y = if flip { -long } else { long };
+    let x = y.cross(&z);
+    let rotation = Rotation3::from_basis_unchecked(&[x, y, z]);
+    Isometry3::from_parts(
+        Translation3::from(point),
+        UnitQuaternion::from_rotation_matrix(&rotation),
+    )
+}
+
+/// The four rotations that map a box onto itself (identity and half turns about its axes).
+pub(super) fn box_symmetries() -> [Isometry3<f64>; 4] {
+    let half_turn = |axis: Vector3<f64>| {
+        Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(
+                &nalgebra::Unit::new_normalize(axis),
+                std::f64::consts::PI,
+            ),
+        )
+    };
+    [
+        Isometry3::identity(),
+        half_turn(Vector3::x()),
+        half_turn(Vector3::y()),
+        half_turn(Vector3::z()),
+    ]
+}

@@ -1,0 +1,278 @@
+//! The executor: runs one wall in its own rapier world. Lumber arrives on the conveyors in
+//! assembly order; for every element the framing subroutine waits for the touch sensor,
+//! approaches, grips, lifts, moves to above the framing target, places, releases and
+//! retracts; then the nailing subroutine drives every nail. An element that cannot be framed
+//! is taken off the belt with its reason recorded, and the run goes on.
+//!
+//! One file per subroutine: `feeding` (conveyors and the touch sensor), `framing` (grip, move,
+//! place), `nailing`, `paths` (collision-free joint motion between poses) and `as_built`
+//! (settling and measuring the result). This file holds the run itself, its clock and what it
+//! records of contacts.
+
+mod as_built;
+mod feeding;
+mod framing;
+mod nailing;
+mod paths;
+
+pub use nailing::NailPlan;
+
+use super::SimOptions;
+use super::motion::{JointMove, LinearMove};
+use super::physics::Physics;
+use super::reach::solve;
+use super::record::{ContactRecord, Operation, WallRecord};
+use crate::cell::{Cell, IkFailure};
+use crate::world::{ScenePiece, SceneWall};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
+
+/// A contact shallower than this is a touch, not a collision (m).
+const CONTACT_TOLERANCE: f64 = 0.001;
+/// An assembly surface this far or less above the floor is the floor itself (m).
+const SURFACE_ON_FLOOR: f64 = 0.005;
+/// How far a framing table reaches beyond the wall laid on it (m).
+const TABLE_BORDER: f64 = 0.05;
+/// Straight-line TCP speed and acceleration.
+pub(super) const LINE_SPEED: f64 = 0.25;
+pub(super) const LINE_ACCEL: f64 = 1.0;
+
+/// The gripped piece: its id, its pose in tool0, its box half sizes.
+#[derive(Debug, Clone)]
+pub(super) struct Held {
+    id: String,
+    in_tool: Isometry3<f64>,
+    half: [f64; 3],
+}
+
+pub struct WallRun<'a> {
+    cell: &'a Cell,
+    options: &'a SimOptions,
+    phys: Physics,
+    wall_cell: Isometry3<f64>,
+    pieces: Vec<&'a ScenePiece>,
+    t: f64,
+    q: Vec<f64>,
+    held: Option<Held>,
+    /// The element and operation contacts are attributed to, and bodies it may touch.
+    current: Option<(String, &'static str, Vec<String>)>,
+    /// Robot/fixed pairs touching at the start (a base on its floor): never reported.
+    resting: BTreeSet<(String, String)>,
+    contacts: BTreeMap<(String, &'static str, String, String), (f64, f64)>,
+    /// Pieces not yet put on conveyor 1, in order.
+    queue: VecDeque<&'a ScenePiece>,
+    /// Pieces on the belts (spawned, not yet picked or removed).
+    on_belts: BTreeSet<String>,
+    placed: BTreeMap<String, Isometry3<f64>>,
+    record: WallRecord,
+    progress: &'a (dyn Fn(usize, usize) + Sync),
+}
+
+impl<'a> WallRun<'a> {
+    pub fn new(
+        cell: &'a Cell,
+        options: &'a SimOptions,
+        wall: &SceneWall,
+        pieces: Vec<&'a ScenePiece>,
+        progress: &'a (dyn Fn(usize, usize) + Sync),
+    ) -> WallRun<'a> {
+        let q = cell.robot.home();
+        let mut phys = Physics::new(cell, &q, options.dt);
+        if cell.assembly.surface_z > cell.floor.z + SURFACE_ON_FLOOR
+            && let Some((min, max)) = footprint(&pieces)
+        {
+            phys.add_assembly_table(
+                [min[0] - TABLE_BORDER, min[1] - TABLE_BORDER],
+                [max[0] + TABLE_BORDER, max[1] + TABLE_BORDER],
+                cell.assembly.surface_z,
+            );
+        }
+        WallRun {
+            cell,
+            options,
+            phys,
+            wall_cell: cell.robot_base * wall.wall_to_robot,
+            pieces,
+            t: 0.0,
+            q,
+            held: None,
+            current: None,
+            resting: BTreeSet::new(),
+            contacts: BTreeMap::new(),
+            queue: VecDeque::new(),
+            on_belts: BTreeSet::new(),
+            placed: BTreeMap::new(),
+            record: WallRecord {
+                wall: wall.id.clone(),
+                ..WallRecord::default()
+            },
+            progress,
+        }
+    }
+
+    /// Runs the wall: framing of every element, then nailing.
+    pub fn run(mut self, nails: &[NailPlan]) -> WallRecord {
+        self.load_belts();
+        self.phys.drive_robot(&self.q.clone());
+        self.step();
+        self.resting = self
+            .phys
+            .robot_contacts(None, CONTACT_TOLERANCE)
+            .into_iter()
+            .map(|(a, b, _)| (a, b))
+            .collect();
+        let total = self.pieces.len();
+        for (done, piece) in self.pieces.clone().into_iter().enumerate() {
+            (self.progress)(done, total);
+            self.frame(piece);
+        }
+        self.record.framing_end = self.t;
+        self.nail_all(nails);
+        self.record.nailing_end = self.t;
+        self.settle();
+        self.measure(nails);
+        (self.progress)(total, total);
+        self.record.contacts = std::mem::take(&mut self.contacts)
+            .into_iter()
+            .map(|((piece, op, a, b), (t, depth))| ContactRecord {
+                piece,
+                op,
+                t,
+                body_a: a,
+                body_b: b,
+                depth,
+            })
+            .collect();
+        self.record
+    }
+}
+
+// ---- time and physics ----
+impl<'a> WallRun<'a> {
+    /// One physics step: the robot follows `q`, a held piece follows the tool, the feeder and
+    /// the sensor act, contacts are recorded.
+    fn step(&mut self) {
+        self.phys.drive_robot(&self.q);
+        if let Some(h) = &self.held {
+            let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
+            self.phys.carry(&h.id, &(tool * h.in_tool));
+        }
+        self.phys.step();
+        self.t += self.options.dt;
+        self.record.steps += 1;
+        self.feed();
+        self.watch_sensor();
+        self.watch_contacts();
+    }
+
+    fn wait(&mut self, seconds: f64) {
+        let steps = (seconds / self.options.dt).ceil().max(1.0) as u64;
+        for _ in 0..steps {
+            self.step();
+        }
+    }
+
+    fn run_joint(&mut self, mv: &JointMove) {
+        let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
+        for k in 1..=steps {
+            self.q = mv.at(k as f64 * self.options.dt);
+            self.step();
+        }
+        self.q = mv.to.clone();
+    }
+
+    /// Follows a straight TCP line; stops (returning the failure) if IK fails on the way.
+    fn run_line(&mut self, mv: &LinearMove, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
+        let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
+        for k in 1..=steps {
+            let pose = mv.pose_at(k as f64 * self.options.dt);
+            self.q = solve(self.cell, &pose, tcp, &self.q)?;
+            self.step();
+        }
+        Ok(())
+    }
+
+    fn begin(&mut self, piece: &str, op: &'static str, may_touch: &[&str]) -> f64 {
+        let mut allowed: Vec<String> = may_touch.iter().map(|p| format!("piece {p}")).collect();
+        allowed.push(format!("piece {piece}"));
+        self.current = Some((piece.to_string(), op, allowed));
+        self.t
+    }
+
+    fn end(&mut self, piece: &str, op: &'static str, start: f64) {
+        self.record.operations.push(Operation {
+            piece: piece.to_string(),
+            op,
+            start,
+            end: self.t,
+        });
+        self.current = None;
+    }
+
+    fn watch_contacts(&mut self) {
+        let Some((piece, op, allowed)) = &self.current else {
+            return;
+        };
+        // While the robot waits for a piece it stands still: what it touches does not change
+        // (a contact it is still in is recorded by the next operation).
+        if *op == "feed" {
+            return;
+        }
+        let held = self.held.as_ref().map(|h| h.id.as_str());
+        for (a, b, depth) in self.phys.robot_contacts(held, CONTACT_TOLERANCE) {
+            if allowed.contains(&b) || self.resting.contains(&(a.clone(), b.clone())) {
+                continue;
+            }
+            let entry = self
+                .contacts
+                .entry((piece.clone(), op, a, b))
+                .or_insert((self.t, depth));
+            entry.1 = entry.1.max(depth);
+        }
+    }
+}
+
+/// The pose `h` higher (cell z).
+pub(super) fn raise(pose: &Isometry3<f64>, h: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::from(pose.translation.vector + Vector3::new(0.0, 0.0, h)),
+        pose.rotation,
+    )
+}
+
+/// How bad an IK failure is, to report the closest miss: metres or radians beyond the limit.
+pub(super) fn failure_score(f: &IkFailure) -> f64 {
+    match f {
+        IkFailure::OutOfReach {
+            distance,
+            reach,
+            min_reach,
+        } => (distance - reach).max(min_reach - distance).max(0.0),
+        IkFailure::JointLimit { excess, .. } => excess.abs(),
+        IkFailure::WristSingularity { margin, required } => (required - margin).max(0.0),
+        // Reachable but colliding: the most telling miss.
+        IkFailure::AllSolutionsCollide { .. } => -1.0,
+        _ => 10.0,
+    }
+}
+
+/// The cell-frame x/y rectangle the pieces cover at their framing targets.
+fn footprint(pieces: &[&ScenePiece]) -> Option<([f64; 2], [f64; 2])> {
+    let mut corners = pieces.iter().flat_map(|p| {
+        let [l, w, t] = p.size.map(|v| v / 2.0);
+        [-1.0, 1.0].into_iter().flat_map(move |a| {
+            [-1.0, 1.0].into_iter().flat_map(move |b| {
+                [-1.0, 1.0]
+                    .into_iter()
+                    .map(move |c| p.target_cell * Point3::new(a * l, b * w, c * t))
+            })
+        })
+    });
+    let first = corners.next()?;
+    let (mut min, mut max) = ([first.x, first.y], [first.x, first.y]);
+    for c in corners {
+        min = [min[0].min(c.x), min[1].min(c.y)];
+        max = [max[0].max(c.x), max[1].max(c.y)];
+    }
+    Some((min, max))
+}
