@@ -113,13 +113,16 @@ fn tm1_targets_on_the_abb_cell() {
     }
 }
 
-/// The laid-flat wall frame from the rules equals `Assembly::wall_to_cell` (robot at the cell
-/// origin in both shipped cells), for both orientations.
+/// The laid-flat wall frame from the rules equals the cell contract computed here (robot at
+/// the cell origin in both shipped cells, a fixed offset), for both orientations: parallel,
+/// v (height) along +x from offset_x and u along -y centred on centre_y; perpendicular, u along
+/// +x from offset_x and v along +y, the height centred on centre_y.
 #[test]
 fn wall_frames_agree_with_the_cell_module() {
     for cell_name in ["study-abb", "study-kuka"] {
         for orientation in [Orientation::Parallel, Orientation::Perpendicular] {
             let mut cell = Cell::load(cell_name).unwrap();
+            cell.set_offset_x("0.531").unwrap();
             cell.assembly.orientation = orientation;
             let (pieces, walls) = targets("tm3.ifc", &cell, RuleEngine::Compiled);
             assert_eq!(walls.len(), 4, "{cell_name}: tm3 has four walls");
@@ -130,7 +133,24 @@ fn wall_frames_agree_with_the_cell_module() {
             for t in r.get("wall_size") {
                 let w = sym(&t[0]);
                 let (l, h) = (t[1].as_float().unwrap(), t[2].as_float().unwrap());
-                let expected = cell.to_robot(&cell.assembly.wall_to_cell(l, h));
+                let a = &cell.assembly;
+                let (origin, u, v) = match orientation {
+                    Orientation::Parallel => (
+                        Vector3::new(0.531, a.centre_y + l / 2.0, a.surface_z),
+                        -Vector3::y(),
+                        Vector3::x(),
+                    ),
+                    Orientation::Perpendicular => (
+                        Vector3::new(0.531, a.centre_y - h / 2.0, a.surface_z),
+                        Vector3::x(),
+                        Vector3::y(),
+                    ),
+                };
+                let rotation = nalgebra::Rotation3::from_basis_unchecked(&[u, v, u.cross(&v)]);
+                let expected = cell.to_robot(&nalgebra::Isometry3::from_parts(
+                    nalgebra::Translation3::from(origin),
+                    nalgebra::UnitQuaternion::from_rotation_matrix(&rotation),
+                ));
                 let got = walls[&w];
                 assert!(
                     close(&got.translation.vector, &expected.translation.vector, 1e-9)
@@ -146,6 +166,7 @@ fn wall_frames_agree_with_the_cell_module() {
 #[test]
 fn perpendicular_targets_run_along_x() {
     let mut cell = Cell::load("study-abb").unwrap();
+    cell.set_offset_x("0.531").unwrap();
     cell.assembly.orientation = Orientation::Perpendicular;
     let (pieces, _) = targets("tm1.ifc", &cell, RuleEngine::Compiled);
     let t = truth("tm1.ifc");

@@ -37,6 +37,9 @@ pub enum IkFailure {
         position_error: f64,
         rotation_error: f64,
     },
+    /// A straight TCP line leaves every IK branch it starts on: following the branch,
+    /// `joint` would jump `jump` (rad or m) between two samples, `at` (0..1) of the way along.
+    BranchJump { joint: String, jump: f64, at: f64 },
     /// The pose has NaN or infinite numbers.
     InvalidPose,
 }
@@ -74,6 +77,11 @@ impl std::fmt::Display for IkFailure {
             } => write!(
                 f,
                 "no exact solution: best residual {position_error:.3e} m, {rotation_error:.3e} rad"
+            ),
+            IkFailure::BranchJump { joint, jump, at } => write!(
+                f,
+                "no continuous solution along the straight line: {joint} would jump {jump:.3} between two poses {:.0} % of the way",
+                at * 100.0
             ),
             IkFailure::InvalidPose => write!(f, "the pose is not finite"),
         }

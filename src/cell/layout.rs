@@ -29,6 +29,8 @@ struct CellFile {
     tool_table: TableSection,
     #[serde(default)]
     floor: FloorSection,
+    #[serde(default)]
+    motion: MotionSection,
 }
 
 #[derive(Debug, Deserialize)]
@@ -50,7 +52,10 @@ struct ToolSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 struct AssemblySection {
-    offset_x: f64,
+    offset_x: OffsetSetting,
+    /// For `offset_x = "auto"`: the offsets searched, m (default: clear of the robot's base
+    /// out to its reach).
+    auto_range: Option<[f64; 2]>,
     orientation: Orientation,
     centre_y: f64,
     surface_z: f64,
@@ -59,13 +64,112 @@ struct AssemblySection {
 impl Default for AssemblySection {
     fn default() -> Self {
         AssemblySection {
-            offset_x: 0.531,
+            offset_x: OffsetSetting::Metres(0.531),
+            auto_range: None,
             orientation: Orientation::Parallel,
             centre_y: 0.0,
             surface_z: 0.0,
         }
     }
 }
+
+/// `offset_x` as written: a distance in m or a word (`"auto"`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum OffsetSetting {
+    Metres(f64),
+    Word(String),
+}
+
+/// Where each wall lies along the robot's x axis.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(tag = "mode", rename_all = "snake_case")]
+pub enum OffsetX {
+    /// Every wall at this distance (m) from the base.
+    Fixed { x: f64 },
+    /// Each wall where the arm reaches the most of its pieces, then nearest the base; the
+    /// offsets searched run from `min` to `max` (m). Chosen by `rules/targets.dl`.
+    Auto { min: f64, max: f64 },
+}
+
+impl OffsetX {
+    /// Parses a command-line or file value: metres or `auto` (searched over `range`).
+    pub fn parse(text: &str, range: [f64; 2]) -> Result<OffsetX, String> {
+        if text.trim() == "auto" {
+            return Ok(OffsetX::Auto {
+                min: range[0],
+                max: range[1],
+            });
+        }
+        match text.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() && (0.0..=100.0).contains(&x) => Ok(OffsetX::Fixed { x }),
+            _ => Err(format!(
+                "expected a distance in m from 0 to 100 or \"auto\", got {text:?}"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for OffsetX {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            OffsetX::Fixed { x } => write!(f, "{x:.3} m"),
+            OffsetX::Auto { min, max } => write!(f, "auto ({min:.3}..{max:.3} m)"),
+        }
+    }
+}
+
+/// How lumber lies on conveyor 1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Arrangement {
+    /// In a line along the belt, `lumber_gap` between one piece's end and the next's.
+    EndToEnd,
+    /// Side by side across the belt (long axis across the travel), `lumber_gap` between
+    /// neighbours; conveyor 1 delivers each piece to conveyor 2's upstream end, where it
+    /// turns onto conveyor 2 long axis first.
+    SideBySide,
+}
+
+/// How fast the robot program runs and how long it dwells: industrial controllers run a
+/// program at a programmed speed, not at the joints' limits.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Motion {
+    /// Fraction of the joints' speed and acceleration limits for free moves while framing.
+    pub transfer_speed: f64,
+    /// TCP speed of straight descents and lifts at pick and place, m/s.
+    pub approach_speed: f64,
+    /// Fraction of the joints' limits for free moves between nails.
+    pub nailing_speed: f64,
+    /// TCP speed of the straight approach to a nail and back, m/s.
+    pub nail_approach_speed: f64,
+    /// TCP acceleration of straight moves, m/s².
+    pub line_accel: f64,
+    /// Closing the grippers, s.
+    pub grip_dwell: f64,
+    /// Opening the grippers, s.
+    pub release_dwell: f64,
+    /// Firing one nail, s.
+    pub fire_dwell: f64,
+}
+
+impl Default for Motion {
+    fn default() -> Self {
+        Motion {
+            transfer_speed: 1.0,
+            approach_speed: 0.25,
+            nailing_speed: 1.0,
+            nail_approach_speed: 0.25,
+            line_accel: 1.0,
+            grip_dwell: 0.5,
+            release_dwell: 0.3,
+            fire_dwell: 0.2,
+        }
+    }
+}
+
+type MotionSection = Motion;
 
 /// How the wall's length lies relative to the robot's y axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
@@ -98,6 +202,12 @@ struct Conveyor1Section {
     speed: f64,
     #[serde(default = "gap")]
     lumber_gap: f64,
+    #[serde(default = "end_to_end")]
+    arrangement: Arrangement,
+}
+
+fn end_to_end() -> Arrangement {
+    Arrangement::EndToEnd
 }
 
 #[derive(Debug, Deserialize)]
@@ -159,41 +269,15 @@ impl Default for FloorSection {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Assembly {
     /// Distance (m) from the robot base origin along +x to the wall's bottom edge
-    /// (parallel) or to its start (perpendicular).
-    pub offset_x: f64,
+    /// (parallel) or to its start (perpendicular), or `auto` (per wall, by the rules).
+    pub offset_x: OffsetX,
+    /// The offsets `auto` searches, m.
+    pub auto_range: [f64; 2],
     pub orientation: Orientation,
     /// The wall is centred on this y (m, robot frame).
     pub centre_y: f64,
     /// Height (m) of the surface the wall lies on.
     pub surface_z: f64,
-}
-
-impl Assembly {
-    /// Where a wall frame lies in the cell frame when the wall is laid flat here: maps wall
-    /// coordinates (u along the wall, v up the wall, w = u × v across its thickness from the
-    /// outer face) to cell coordinates. The outer face lies on the surface (w points up).
-    /// * parallel: v (height) runs along +x from `offset_x`, u along −y, centred on `centre_y`;
-    /// * perpendicular: u (length) runs along +x from `offset_x`, v along +y, the height
-    ///   centred on `centre_y`.
-    pub fn wall_to_cell(&self, length: f64, height: f64) -> Isometry3<f64> {
-        let (origin, u, v) = match self.orientation {
-            Orientation::Parallel => (
-                Vector3::new(self.offset_x, self.centre_y + length / 2.0, self.surface_z),
-                -Vector3::y(),
-                Vector3::x(),
-            ),
-            Orientation::Perpendicular => (
-                Vector3::new(self.offset_x, self.centre_y - height / 2.0, self.surface_z),
-                Vector3::x(),
-                Vector3::y(),
-            ),
-        };
-        let rot = nalgebra::Rotation3::from_basis_unchecked(&[u, v, u.cross(&v)]);
-        Isometry3::from_parts(
-            Translation3::from(origin),
-            UnitQuaternion::from_rotation_matrix(&rot),
-        )
-    }
 }
 
 /// A belt conveyor. `pose`: centre of the belt's top surface, x along the travel direction.
@@ -271,6 +355,10 @@ pub struct Cell {
     pub conveyor2: Conveyor,
     /// Gap between lumber pieces on conveyor 1, m.
     pub lumber_gap: f64,
+    /// How lumber lies on conveyor 1.
+    pub arrangement: Arrangement,
+    /// Programmed speeds and dwells.
+    pub motion: Motion,
     pub touch_sensor: TouchSensor,
     pub pick: Pick,
     pub tool_table: ToolTable,
@@ -309,6 +397,12 @@ impl Cell {
             Translation3::from(self.pick.point.coords + Vector3::new(0.0, 0.0, height)),
             UnitQuaternion::from_rotation_matrix(&rot),
         )
+    }
+
+    /// Overrides the cell's `offset_x` (a distance in m, or `auto`), as the command line does.
+    pub fn set_offset_x(&mut self, text: &str) -> Result<(), String> {
+        self.assembly.offset_x = OffsetX::parse(text, self.assembly.auto_range)?;
+        Ok(())
     }
 
     /// A cell-frame pose in the robot's base_link frame.
@@ -387,13 +481,31 @@ impl Cell {
         coord("robot", "base_position", &f.robot.base_position)?;
         finite_angle("robot", "base_yaw_deg", f.robot.base_yaw_deg)?;
         let a = &f.assembly;
-        if !(a.offset_x.is_finite() && (0.0..=100.0).contains(&a.offset_x)) {
-            return Err(bad(
-                "assembly",
-                "offset_x",
-                format!("expected a distance in m from 0 to 100, got {}", a.offset_x),
-            ));
+        let auto_range = match a.auto_range {
+            Some(r) => {
+                if !(r.iter().all(|x| x.is_finite() && (0.0..=100.0).contains(x)) && r[0] < r[1]) {
+                    return Err(bad(
+                        "assembly",
+                        "auto_range",
+                        format!("expected [min, max] in m with 0 <= min < max <= 100, got {r:?}"),
+                    ));
+                }
+                r
+            }
+            None => [
+                base_clearance(&robot),
+                robot
+                    .meta
+                    .reach
+                    .unwrap_or(3.0)
+                    .max(base_clearance(&robot) + 0.1),
+            ],
+        };
+        let offset_x = match &a.offset_x {
+            OffsetSetting::Metres(x) => OffsetX::parse(&x.to_string(), auto_range),
+            OffsetSetting::Word(w) => OffsetX::parse(w, auto_range),
         }
+        .map_err(|m| bad("assembly", "offset_x", m))?;
         coord("assembly", "centre_y", &[a.centre_y])?;
         coord("assembly", "surface_z", &[a.surface_z])?;
         let c1 = &f.conveyor1;
@@ -450,6 +562,7 @@ impl Cell {
         size("tool_table", "size", &t.size, 10.0)?;
         size("tool_table", "leg_height", &[t.leg_height], 5.0)?;
         size("floor", "size", &f.floor.size, 1000.0)?;
+        check_motion(&f.motion).map_err(|(key, m)| bad("motion", key, m))?;
         coord("floor", "z", &[f.floor.z])?;
 
         // Payload: the tool alone must not exceed it (the lumber comes on top; the executor checks).
@@ -510,7 +623,8 @@ impl Cell {
             ),
             tool,
             assembly: Assembly {
-                offset_x: a.offset_x,
+                offset_x,
+                auto_range,
                 orientation: a.orientation,
                 centre_y: a.centre_y,
                 surface_z: a.surface_z,
@@ -518,6 +632,8 @@ impl Cell {
             conveyor1,
             conveyor2,
             lumber_gap: c1.lumber_gap,
+            arrangement: c1.arrangement,
+            motion: f.motion,
             touch_sensor,
             pick: Pick {
                 point: face - dir * s.pick_offset,
@@ -583,4 +699,83 @@ impl Cell {
         self.pick.margins = margins;
         Ok(())
     }
+}
+
+/// How far from the base axis (m) a wall must start to stay clear of the base and the
+/// turntable above it: the widest of their collision shapes, turned about the base axis, plus
+/// 5 cm.
+fn base_clearance(robot: &Robot) -> f64 {
+    let q = robot.home();
+    let poses = robot.fk_all(&q);
+    // The base and the links carried by the first joint only (they turn about the base axis):
+    // links with at most one moving joint between them and the root.
+    let moving_joints_above = |mut link: usize| {
+        let mut n = 0;
+        while let Some(j) = robot.links[link].parent_joint {
+            n += usize::from(robot.joints[j].dof_index.is_some());
+            link = robot.joints[j].parent;
+        }
+        n
+    };
+    let radius = robot
+        .links
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| moving_joints_above(*i) <= 1)
+        .flat_map(|(i, link)| link.collisions.iter().map(move |c| (i, c)))
+        .map(|(i, c)| {
+            let centre = (poses[i] * c.origin).translation.vector;
+            centre.xy().norm() + bounding_radius(&c.shape)
+        })
+        .fold(0.0, f64::max);
+    radius + 0.05
+}
+
+/// The radius of a ball around the shape's origin that holds it.
+fn bounding_radius(shape: &super::shapes::Shape) -> f64 {
+    use super::shapes::Shape;
+    match *shape {
+        Shape::Box { half_extents: h } => (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt(),
+        Shape::Cylinder { radius, length } => (radius * radius + length * length / 4.0).sqrt(),
+        Shape::Capsule { radius, length } => radius + length / 2.0,
+        Shape::Sphere { radius } => radius,
+    }
+}
+
+/// Motion settings: speed fractions in (0, 1], TCP speeds and accelerations positive and at
+/// most 10, dwells from 0 to 60 s. Err: the key and what is wrong.
+fn check_motion(m: &Motion) -> Result<(), (&'static str, String)> {
+    for (key, v) in [
+        ("transfer_speed", m.transfer_speed),
+        ("nailing_speed", m.nailing_speed),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v <= 1.0) {
+            return Err((
+                key,
+                format!("expected a fraction of the joint limits in (0, 1], got {v}"),
+            ));
+        }
+    }
+    for (key, v) in [
+        ("approach_speed", m.approach_speed),
+        ("nail_approach_speed", m.nail_approach_speed),
+        ("line_accel", m.line_accel),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v <= 10.0) {
+            return Err((
+                key,
+                format!("expected a value above 0 and at most 10, got {v}"),
+            ));
+        }
+    }
+    for (key, v) in [
+        ("grip_dwell", m.grip_dwell),
+        ("release_dwell", m.release_dwell),
+        ("fire_dwell", m.fire_dwell),
+    ] {
+        if !(v.is_finite() && (0.0..=60.0).contains(&v)) {
+            return Err((key, format!("expected a time in s from 0 to 60, got {v}")));
+        }
+    }
+    Ok(())
 }

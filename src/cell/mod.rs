@@ -15,13 +15,17 @@ mod meta;
 mod opw;
 mod robot;
 mod shapes;
+pub mod tcp_poses;
 mod toml_file;
 mod tool;
 
 pub use builtin::{cell_names, robot_names, tool_names};
 pub use error::CellError;
 pub use ik::{IkFailure, IkOptions};
-pub use layout::{Assembly, Cell, Conveyor, Floor, Orientation, Pick, ToolTable, TouchSensor};
+pub use layout::{
+    Arrangement, Assembly, Cell, Conveyor, Floor, Motion, OffsetX, Orientation, Pick, ToolTable,
+    TouchSensor,
+};
 pub use meta::{OpwParams, RobotMeta};
 pub use robot::{Inertial, Joint, JointKind, Link, Robot};
 pub use shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};

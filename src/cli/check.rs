@@ -5,6 +5,7 @@
 use super::{CmdResult, Failure, print_stdout};
 use framewright::cell::Cell;
 use framewright::frame::cell_facts::cell_facts;
+use framewright::frame::placement::add_placement_facts;
 use framewright::frame::{Facts, RuleEngine, model_facts, reason};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
@@ -47,27 +48,42 @@ pub struct ReasoningInputs {
     /// Largest gap between two pieces still taken as touching, millimetres.
     #[arg(long, value_name = "MM", default_value_t = 3.0)]
     pub contact_tolerance: f64,
+    /// Where walls lie along the robot's x axis, overriding the cell: metres from the base
+    /// to the wall's bottom edge, or `auto` (each wall where the arm reaches most of it).
+    #[arg(long, value_name = "M|auto")]
+    pub offset_x: Option<String>,
+}
+
+/// Loads a cell and applies a command-line `--offset-x`.
+pub fn load_cell(name: &str, offset_x: Option<&str>) -> Result<Cell, Failure> {
+    let mut cell = Cell::load(name)?;
+    if let Some(text) = offset_x {
+        cell.set_offset_x(text)
+            .map_err(|m| Failure::bad_input(format!("--offset-x: {m}")))?;
+    }
+    Ok(cell)
 }
 
 /// The model, the cell and their facts (what plan, check and why start from).
 pub fn load_inputs(
     model: &Path,
-    cell: &str,
-    contact_tolerance_mm: f64,
+    inputs: &ReasoningInputs,
 ) -> Result<(Model, Cell, Facts), Failure> {
+    let contact_tolerance_mm = inputs.contact_tolerance;
     if !(contact_tolerance_mm.is_finite() && (0.0..=100.0).contains(&contact_tolerance_mm)) {
         return Err(Failure::bad_input(format!(
             "--contact-tolerance {contact_tolerance_mm} mm is out of range; give 0 to 100 mm"
         )));
     }
     let model = Model::open(model)?;
-    let cell = Cell::load(cell)?;
+    let cell = load_cell(&inputs.cell, inputs.offset_x.as_deref())?;
     let contacts = ContactOptions {
         tolerance: contact_tolerance_mm / 1000.0,
         ..ContactOptions::default()
     };
     let mut facts = model_facts(&model, &contacts);
     facts.extend(cell_facts(&cell));
+    add_placement_facts(&mut facts, &cell, &rule_base(&inputs.rules_dir))?;
     Ok((model, cell, facts))
 }
 
@@ -108,7 +124,7 @@ pub fn run(args: CheckArgs) -> CmdResult {
         }
         // The executor reads the model and reasons itself.
         let model = Model::open(&args.model)?;
-        let cell = Cell::load(&args.inputs.cell)?;
+        let cell = load_cell(&args.inputs.cell, args.inputs.offset_x.as_deref())?;
         let options = SimOptions {
             walls: args.walls.clone(),
             engine: base.clone(),
@@ -118,11 +134,7 @@ pub fn run(args: CheckArgs) -> CmdResult {
         let findings = user.evaluate(&sim.reasoned.relations)?;
         return report(&args, &model, &cell.name, &findings);
     }
-    let (model, cell, facts) = load_inputs(
-        &args.model,
-        &args.inputs.cell,
-        args.inputs.contact_tolerance,
-    )?;
+    let (model, cell, facts) = load_inputs(&args.model, &args.inputs)?;
     let reasoned = reason(&facts, &base, false)?;
     let findings = user.evaluate(&reasoned.relations)?;
     report(&args, &model, &cell.name, &findings)

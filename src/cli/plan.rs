@@ -21,7 +21,7 @@ pub struct PlanArgs {
 
 pub fn run(args: PlanArgs) -> CmdResult {
     let inputs = &args.inputs;
-    let (model, _, facts) = load_inputs(&args.model, &inputs.cell, inputs.contact_tolerance)?;
+    let (model, _, facts) = load_inputs(&args.model, inputs)?;
     let reasoned = reason(&facts, &rule_base(&inputs.rules_dir), false)?;
     let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
     if args.json {

@@ -345,7 +345,7 @@ fn cell_summary(name: &str, json: bool) -> CmdResult {
         cell.robot.meta.payload.unwrap_or(f64::NAN)
     );
     out.push_str(&format!(
-        "  assembly: wall {:?} to robot y, from x = {:.3} m, centred on y = {:.3} m\n",
+        "  assembly: wall {:?} to robot y, from x = {}, centred on y = {:.3} m\n",
         cell.assembly.orientation, cell.assembly.offset_x, cell.assembly.centre_y
     ));
     out.push_str(&format!(

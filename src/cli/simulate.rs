@@ -1,8 +1,8 @@
 //! `framewright simulate MODEL.ifc [--cell C] [--json] [--wall W]…`: runs the framing and
 //! nailing of every wall in the physics simulation and prints the verdicts.
 
+use super::check::load_cell;
 use super::{CmdResult, print_stdout, write_stdout};
-use framewright::cell::Cell;
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::report::simulate::SimReport;
@@ -37,14 +37,18 @@ pub struct SimulateArgs {
     /// Physics time step, milliseconds.
     #[arg(long, value_name = "MS", default_value_t = 1000.0 / 240.0)]
     pub step_ms: f64,
-    /// Fraction of the robot's joint speed and acceleration limits to move at (0..1].
+    /// Fraction of the cell's programmed speeds to move at (0..1].
     #[arg(long, default_value_t = 1.0)]
     pub speed: f64,
+    /// Where walls lie along the robot's x axis, overriding the cell: metres from the base
+    /// to the wall's bottom edge, or `auto` (each wall where the arm reaches most of it).
+    #[arg(long, value_name = "M|auto")]
+    pub offset_x: Option<String>,
 }
 
 pub fn run(args: SimulateArgs) -> CmdResult {
     let model = Model::open(&args.model)?;
-    let cell = Cell::load(&args.cell)?;
+    let cell = load_cell(&args.cell, args.offset_x.as_deref())?;
     let options = SimOptions {
         walls: args.walls,
         dt: args.step_ms / 1000.0,

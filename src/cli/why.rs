@@ -121,8 +121,7 @@ fn failure(e: WhyError) -> Failure {
 pub fn run_why(args: WhyArgs) -> CmdResult {
     let c = &args.common;
     let base = rule_base(&c.inputs.rules_dir);
-    let (model, cell, mut facts) =
-        load_inputs(&args.model, &c.inputs.cell, c.inputs.contact_tolerance)?;
+    let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
     let simulated = simulate_walls(
         c,
         &args.model,
@@ -178,8 +177,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
 pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     let c = &args.common;
     let base = rule_base(&c.inputs.rules_dir);
-    let (model, cell, mut facts) =
-        load_inputs(&args.model, &c.inputs.cell, c.inputs.contact_tolerance)?;
+    let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
     let ids = piece_ids_in(&model, &args.tuple);
     simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
     let ctx = Context {

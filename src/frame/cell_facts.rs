@@ -10,7 +10,9 @@
 //! | `robot_base_x`, `_y`, `_z` | value | robot `base_link` origin in the cell frame |
 //! | `robot_base_yaw` | value | robot base rotation about z, rad |
 //! | `robot_payload` | value | rated payload, kg (absent when the robot's metadata has none) |
-//! | `assembly_offset_x` | value | robot +x distance from the base to the wall's bottom edge (parallel) or start (perpendicular) |
+//! | `assembly_offset` | choice | `fixed` (every wall at `assembly_offset_x`) or `auto` (each wall placed by `rules/targets.dl` from the reach facts of `frame::placement`) |
+//! | `assembly_offset_x` | value | fixed: robot +x distance from the base to the wall's bottom edge (parallel) or start (perpendicular) |
+//! | `assembly_offset_min`, `_max` | value | auto: the offsets searched |
 //! | `assembly_centre_y` | value | robot-frame y the laid-flat wall is centred on |
 //! | `assembly_surface_z` | value | robot-frame height of the surface the wall lies on |
 //! | `assembly_orientation` | choice | `parallel` (wall length along robot y) or `perpendicular` (along robot x) |
@@ -19,13 +21,14 @@
 //! | `conveyor1_length`, `conveyor1_width` | value | belt size |
 //! | `conveyor1_speed` | value | belt speed, m/s |
 //! | `conveyor1_lumber_gap` | value | gap between consecutive pieces on the belt (0.150 in the study) |
+//! | `conveyor1_arrangement` | choice | `end_to_end` (pieces in a line along the belt) or `side_by_side` (across it, fed sideways onto conveyor 2) |
 //! | `conveyor2_x`, `_y`, `_z`, `_yaw`, `_length`, `_width`, `_speed` | value | the same for conveyor 2 |
 //! | `tool_mass` | value | mass of the end effector, kg |
 //! | `gripper_spacing`, `gripper_open_width`, `gripper_closed_width` | value | the tool's grippers (absent for a tool without) |
 //! | `cell_name`, `robot_name`, `tool_name` | choice | names, for messages |
 
 use super::facts::Facts;
-use crate::cell::{Cell, Conveyor, Orientation};
+use crate::cell::{Arrangement, Cell, Conveyor, OffsetX, Orientation};
 use crate::logic::{Origin, Value};
 
 /// The facts of a cell (keys above), each tuple from the cell file.
@@ -51,7 +54,13 @@ pub fn cell_facts(cell: &Cell) -> Facts {
         value("robot_payload", payload);
     }
     let a = &cell.assembly;
-    value("assembly_offset_x", a.offset_x);
+    match a.offset_x {
+        OffsetX::Fixed { x } => value("assembly_offset_x", x),
+        OffsetX::Auto { min, max } => {
+            value("assembly_offset_min", min);
+            value("assembly_offset_max", max);
+        }
+    }
     value("assembly_centre_y", a.centre_y);
     value("assembly_surface_z", a.surface_z);
     conveyor_values(&mut value, "conveyor1", &cell.conveyor1);
@@ -76,6 +85,20 @@ pub fn cell_facts(cell: &Cell) -> Facts {
         match a.orientation {
             Orientation::Parallel => "parallel",
             Orientation::Perpendicular => "perpendicular",
+        },
+    );
+    choice(
+        "assembly_offset",
+        match a.offset_x {
+            OffsetX::Fixed { .. } => "fixed",
+            OffsetX::Auto { .. } => "auto",
+        },
+    );
+    choice(
+        "conveyor1_arrangement",
+        match cell.arrangement {
+            Arrangement::EndToEnd => "end_to_end",
+            Arrangement::SideBySide => "side_by_side",
         },
     );
     choice("cell_name", &cell.name);

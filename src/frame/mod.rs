@@ -4,6 +4,7 @@
 
 pub mod cell_facts;
 pub mod facts;
+pub mod placement;
 pub mod plan;
 
 use crate::logic::compiled::{self, Relations};

@@ -5,7 +5,7 @@
 //! rapier works in f32 with glam types; the rest of framewright in f64 with nalgebra. The
 //! conversions live here.
 
-use crate::cell::{Cell, PlacedShape, Shape};
+use crate::cell::{Arrangement, Cell, PlacedShape, Shape};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
@@ -40,6 +40,9 @@ const BELT_SLAB: f64 = 0.10;
 /// Conveyor 2's belt lies this much below its nominal height: lumber sliding across a seam
 /// between two flush slabs catches on the second slab's end face; a small step down does not.
 const TRANSFER_STEP: f64 = 0.002;
+/// The stop rail at the downstream end of a side-by-side conveyor 1: thickness along the
+/// travel, height above the belt (m).
+const RAIL_SIZE: [f64; 2] = [0.01, 0.03];
 /// How far in front of the end stop the sensor zone reaches.
 const SENSOR_REACH: f64 = 0.005;
 /// Finger plate thickness of a parallel gripper's jaws.
@@ -187,6 +190,30 @@ impl Physics {
                     ),
                 );
             }
+        }
+
+        // Side by side, conveyor 1 pushes its lumber against a low stop rail along its
+        // downstream end; the transfer (the executor's feeder) lifts each piece over it onto
+        // conveyor 2 when that belt is free.
+        if cell.arrangement == Arrangement::SideBySide {
+            let c = &cell.conveyor1;
+            let rail = c.pose
+                * Isometry3::translation(
+                    c.length / 2.0 + RAIL_SIZE[0] / 2.0,
+                    0.0,
+                    RAIL_SIZE[1] / 2.0,
+                );
+            add_fixed(
+                &mut world,
+                &mut names,
+                "conveyor 1 stop rail",
+                rail,
+                ColliderBuilder::cuboid(
+                    RAIL_SIZE[0] as f32 / 2.0,
+                    c.width as f32 / 2.0,
+                    RAIL_SIZE[1] as f32 / 2.0,
+                ),
+            );
         }
 
         // The touch sensor: a solid end stop the lumber runs into, and a thin sensing zone

@@ -34,7 +34,8 @@ pub fn reach_margin(cell: &Cell, pose_cell: &Isometry3<f64>, tcp: &Isometry3<f64
 }
 
 /// Joint values at the end of a straight TCP line from `q_from` (at `from`) to `to`, checked
-/// at `samples` points along the way (each the solution closest to the previous one).
+/// at `samples` points along the way (each the solution closest to the previous one). Err
+/// with `BranchJump` when the branch of `q_from` does not reach `to` without a jump.
 pub fn line(
     cell: &Cell,
     q_from: &[f64],
@@ -49,20 +50,57 @@ pub fn line(
         let t = from.translation.vector.lerp(&to.translation.vector, s);
         let r = from.rotation.slerp(&to.rotation, s);
         let next = solve(cell, &Isometry3::from_parts(t.into(), r), tcp, &q)?;
-        let jump = next
-            .iter()
-            .zip(&q)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        if jump > MAX_BRANCH_STEP && k > 1 {
-            return Err(IkFailure::NoExactSolution {
-                position_error: 0.0,
-                rotation_error: jump,
-            });
-        }
+        check_step(cell, &q, &next, s)?;
         q = next;
     }
     Ok(q)
+}
+
+/// A straight TCP line from `from` to `to` on an IK branch that exists along all of it: the
+/// solutions at `from`, nearest `seed` first, are followed in turn; Ok((joints at `from`,
+/// joints at `to`)) of the first that gets there without a jump.
+pub fn continuous_line(
+    cell: &Cell,
+    seed: &[f64],
+    from: &Isometry3<f64>,
+    to: &Isometry3<f64>,
+    tcp: &Isometry3<f64>,
+    samples: usize,
+) -> Result<(Vec<f64>, Vec<f64>), IkFailure> {
+    let starts = cell.robot.ik(&cell.to_robot(from), tcp, seed)?;
+    let mut first_failure = None;
+    for start in starts {
+        match line(cell, &start, from, to, tcp, samples) {
+            Ok(end) => return Ok((start, end)),
+            Err(f) => {
+                first_failure.get_or_insert(f);
+            }
+        }
+    }
+    Err(first_failure.unwrap_or(IkFailure::InvalidPose))
+}
+
+/// Err(BranchJump) when a joint moves more than MAX_BRANCH_STEP between two line samples,
+/// `at` (0..1) of the way along.
+pub fn check_step(cell: &Cell, q: &[f64], next: &[f64], at: f64) -> Result<(), IkFailure> {
+    let (i, jump) = next
+        .iter()
+        .zip(q)
+        .map(|(a, b)| (a - b).abs())
+        .enumerate()
+        .fold(
+            (0, 0.0),
+            |best, (i, d)| if d > best.1 { (i, d) } else { best },
+        );
+    if jump > MAX_BRANCH_STEP {
+        let joint = cell
+            .robot
+            .active_joints()
+            .nth(i)
+            .map_or_else(|| format!("joint {}", i + 1), |j| j.name.clone());
+        return Err(IkFailure::BranchJump { joint, jump, at });
+    }
+    Ok(())
 }
 
 /// What the arm would touch at joint values `q` holding `held` (its id, its pose in tool0 and

@@ -132,6 +132,7 @@ pub fn failure_columns(f: &IkFailure) -> (&'static str, String, f64, f64) {
             *position_error,
             *rotation_error,
         ),
+        IkFailure::BranchJump { joint, jump, at } => ("branch_jump", joint.clone(), *jump, *at),
         IkFailure::InvalidPose => ("invalid_pose", String::new(), 0.0, 0.0),
     }
 }

@@ -111,6 +111,7 @@ impl Scene {
     pub fn reason(model: &Model, cell: &Cell, engine: &RuleEngine) -> Result<Reasoned, WorldError> {
         let mut facts = model_facts(model, &ContactOptions::default());
         facts.extend(cell_facts(cell));
+        crate::frame::placement::add_placement_facts(&mut facts, cell, engine)?;
         Ok(reason(&facts, engine, false)?)
     }
 

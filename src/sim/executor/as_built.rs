@@ -14,7 +14,7 @@ impl<'a> WallRun<'a> {
     pub(super) fn settle(&mut self) {
         let home = self.cell.robot.home();
         let tcp = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
-        self.move_to(&home, &tcp, &[]);
+        self.move_to(&home, &tcp, &[], self.transfer_speed());
         self.wait(SETTLE_TIME);
     }
 

@@ -2,9 +2,13 @@
 //! stops them when a piece arrives.
 
 use super::WallRun;
+use crate::cell::Arrangement;
 use crate::sim::record::BeltEvent;
 use crate::world::ScenePiece;
-use nalgebra::{Isometry3, Translation3, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+
+/// A piece this close to conveyor 1's stop rail is at the rail (m).
+const TRANSFER_REACH: f64 = 0.005;
 
 impl<'a> WallRun<'a> {
     /// Puts every piece whose spawn pose lies on conveyor 1 there; the rest wait in the queue.
@@ -28,10 +32,17 @@ impl<'a> WallRun<'a> {
     /// The feeder: the next queued piece goes onto conveyor 1's upstream end once the belt
     /// there is clear by the lumber gap.
     pub(super) fn feed(&mut self) {
+        if self.cell.arrangement == Arrangement::SideBySide {
+            self.transfer();
+        }
         let Some(next) = self.queue.front().copied() else {
             return;
         };
-        let length = next.size[0];
+        // How much of the belt's travel it takes up (its length end to end, its thickness
+        // side by side).
+        let direction = self.cell.conveyor1.direction();
+        let local = next.spawn.rotation.inverse() * direction;
+        let length: f64 = (0..3).map(|i| local[i].abs() * next.size[i]).sum();
         let clear = self.on_belts.iter().all(|id| {
             let Some(pose) = self.phys.lumber_pose(id) else {
                 return true;
@@ -53,6 +64,53 @@ impl<'a> WallRun<'a> {
         self.queue.pop_front();
         self.phys.add_lumber(next, &pose);
         self.on_belts.insert(next.id.clone());
+    }
+
+    /// Side by side: the piece at conveyor 1's stop rail is lifted onto conveyor 2's centre
+    /// line, long axis along the belt, once no other piece is on conveyor 2 (a transfer arm
+    /// between the two belts; it does not change where the piece lies along conveyor 2).
+    fn transfer(&mut self) {
+        if !self.phys.belts.running {
+            return;
+        }
+        let c1 = &self.cell.conveyor1;
+        let c2 = &self.cell.conveyor2;
+        let on_conveyor2 = |pose: &Isometry3<f64>| {
+            let local = c2.pose.inverse() * Point3::from(pose.translation.vector);
+            local.x.abs() <= c2.length / 2.0 && local.y.abs() <= c2.width / 2.0
+        };
+        let mut at_rail = None;
+        for id in &self.on_belts {
+            let Some(pose) = self.phys.lumber_pose(id) else {
+                continue;
+            };
+            if self.transferred.contains(id) || on_conveyor2(&pose) {
+                if self.transferred.contains(id) {
+                    return; // conveyor 2 is busy
+                }
+                continue;
+            }
+            let half = piece_half_along(&pose, &c1.direction(), id, &self.pieces);
+            let front = self.belt1_position(&pose.translation.vector) + half;
+            if at_rail.is_none() && front >= c1.length - TRANSFER_REACH {
+                at_rail = Some((id.clone(), pose));
+            }
+        }
+        let Some((id, pose)) = at_rail else {
+            return;
+        };
+        let Some(piece) = self.pieces.iter().copied().find(|p| p.id == id) else {
+            return;
+        };
+        // Onto conveyor 2's centre line at the same place along it, on its belt.
+        let local = c2.pose.inverse() * Point3::from(pose.translation.vector);
+        let lift = c2.pose.translation.z - c1.pose.translation.z;
+        let centre = c2.pose * Point3::new(local.x, 0.0, local.z + lift);
+        let upright =
+            Isometry3::from_parts(Translation3::from(centre.coords), piece.spawn.rotation);
+        self.phys.remove_lumber(&id);
+        self.phys.add_lumber(piece, &upright);
+        self.transferred.insert(id);
     }
 
     pub(super) fn watch_sensor(&mut self) {
@@ -109,7 +167,7 @@ impl<'a> WallRun<'a> {
             .iter()
             .filter(|p| self.on_belts.contains(&p.id) || self.queue.iter().any(|q| q.id == p.id))
             .take_while(|p| p.id != piece.id)
-            .map(|p| p.size[0] + self.cell.lumber_gap)
+            .map(|p| p.size.iter().copied().fold(0.0, f64::max) + self.cell.lumber_gap)
             .sum();
         let limit = 60.0
             + 1.5 * (ahead + piece.size[0] + c1.length + self.cell.conveyor2.length) / c1.speed;

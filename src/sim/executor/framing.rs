@@ -1,10 +1,10 @@
 //! Framing: grip a piece at the sensor, carry it above its framing target, place and release it.
 
 use super::paths::distance;
-use super::{Held, LINE_ACCEL, LINE_SPEED, WallRun, failure_score, raise};
+use super::{Held, WallRun, failure_score, raise};
 use crate::cell::IkFailure;
 use crate::sim::motion::LinearMove;
-use crate::sim::reach::{line, reach_margin, solve, touches};
+use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
 use crate::sim::record::IkRecord;
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
@@ -13,10 +13,14 @@ use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 pub(super) const CLEARANCE: f64 = 0.25;
 /// A piece is released this far above its target and drops into place (m).
 pub(super) const RELEASE_GAP: f64 = 0.001;
-pub(super) const GRIP_TIME: f64 = 0.5;
-pub(super) const RELEASE_TIME: f64 = 0.3;
 /// A piece more than this far from where the plan expected it when the jaws close is not
 /// held (m).
+/// Steps of the grip point from a piece's middle towards its leading end (m)...
+const GRIP_SHIFT_STEP: f64 = 0.1;
+/// ...keeping the front gripper this far inside the piece's end (m).
+const GRIP_END_MARGIN: f64 = 0.05;
+/// Samples checked along a straight descent while planning.
+const LINE_SAMPLES: usize = 10;
 pub(super) const GRIP_TOLERANCE: f64 = 0.005;
 /// A piece that ran into the sensor's end stop settles this long before the robot plans its
 /// grip (s).
@@ -105,16 +109,27 @@ impl<'a> WallRun<'a> {
         if let Some(current) = &mut self.current {
             current.2.clear();
         }
-        self.move_to(&plan.q_above_pick.clone(), &grip, &[]);
+        self.move_to(
+            &plan.q_above_pick.clone(),
+            &grip,
+            &[],
+            self.transfer_speed(),
+        );
         if let Some(current) = &mut self.current {
             current.2.push(format!("piece {id}"));
         }
         let above_pick = raise(&plan.pick, CLEARANCE);
         let ok = self
             .run_line(
-                &LinearMove::new(above_pick, plan.pick, LINE_SPEED, LINE_ACCEL),
+                &LinearMove::new(
+                    above_pick,
+                    plan.pick,
+                    self.approach_speed(),
+                    self.cell.motion.line_accel,
+                ),
                 &grip,
             )
+            .map_err(|f| self.record_line_failure(piece, "pick", f))
             .is_ok();
         let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
         let body = self.phys.lumber_pose(id).unwrap_or(piece.spawn);
@@ -132,8 +147,8 @@ impl<'a> WallRun<'a> {
                 &LinearMove::new(
                     plan.pick,
                     raise(&plan.pick, CLEARANCE),
-                    LINE_SPEED,
-                    LINE_ACCEL,
+                    self.approach_speed(),
+                    self.cell.motion.line_accel,
                 ),
                 &grip,
             );
@@ -152,7 +167,7 @@ impl<'a> WallRun<'a> {
         // on a free piece would knock it over.
         self.phys.attach(id);
         self.phys.set_jaws(Some(piece.size[2]));
-        self.wait(GRIP_TIME);
+        self.wait(self.cell.motion.grip_dwell);
         self.held = Some(Held {
             id: id.to_string(),
             in_tool: tool.inverse() * body,
@@ -161,9 +176,15 @@ impl<'a> WallRun<'a> {
         let ok = ok
             && self
                 .run_line(
-                    &LinearMove::new(plan.pick, above_pick, LINE_SPEED, LINE_ACCEL),
+                    &LinearMove::new(
+                        plan.pick,
+                        above_pick,
+                        self.approach_speed(),
+                        self.cell.motion.line_accel,
+                    ),
                     &grip,
                 )
+                .map_err(|f| self.record_line_failure(piece, "pick", f))
                 .is_ok();
         self.on_belts.remove(id);
         self.start_belts(id);
@@ -189,7 +210,7 @@ impl<'a> WallRun<'a> {
         // Move above the target.
         let start = self.begin(id, "move", &[]);
         if ok {
-            self.move_to(&q_above_place, &grip, &[]);
+            self.move_to(&q_above_place, &grip, &[], self.transfer_speed());
         }
         self.end(id, "move", start);
 
@@ -200,18 +221,29 @@ impl<'a> WallRun<'a> {
         let ok = ok
             && self
                 .run_line(
-                    &LinearMove::new(above_place, release, LINE_SPEED, LINE_ACCEL),
+                    &LinearMove::new(
+                        above_place,
+                        release,
+                        self.approach_speed(),
+                        self.cell.motion.line_accel,
+                    ),
                     &grip,
                 )
+                .map_err(|f| self.record_line_failure(piece, "place", f))
                 .is_ok();
         self.phys.set_jaws(None);
         self.phys.detach(id);
         self.held = None;
-        self.wait(RELEASE_TIME);
+        self.wait(self.cell.motion.release_dwell);
         self.end(id, "place", start);
         let start = self.begin(id, "retract", &[]);
         let _ = self.run_line(
-            &LinearMove::new(release, above_place, LINE_SPEED, LINE_ACCEL),
+            &LinearMove::new(
+                release,
+                above_place,
+                self.approach_speed(),
+                self.cell.motion.line_accel,
+            ),
             &grip,
         );
         self.end(id, "retract", start);
@@ -220,6 +252,16 @@ impl<'a> WallRun<'a> {
             self.phys.clamp(id);
             self.placed.insert(id.to_string(), plan.target);
         }
+    }
+
+    /// A straight move of a framing that failed on the way: recorded against the piece, so
+    /// that it is not placed without a reason.
+    fn record_line_failure(&mut self, piece: &ScenePiece, op: &'static str, failure: IkFailure) {
+        self.record.ik.push(IkRecord {
+            piece: piece.id.clone(),
+            op,
+            result: Err(failure),
+        });
     }
 
     /// Whether the gripper can take the piece: jaws across its thickness, both grippers on it.
@@ -262,8 +304,19 @@ impl<'a> WallRun<'a> {
                 miss = Some((score, op, f));
             }
         };
-        for flip in [false, true] {
-            let pick = grip_pose(&body, piece, &along, self.cell.pick.offset, flip);
+        // The study grips at the centre of mass; where the arm cannot pick or place a piece
+        // gripped there (a long plate whose middle lies far up the belt), the grip moves
+        // towards the leading end, the nearest to the centre that works.
+        let spacing = self.cell.tool.gripper.as_ref().map_or(0.0, |g| g.spacing);
+        let furthest = (piece.size[0] / 2.0 - spacing / 2.0 - GRIP_END_MARGIN).max(0.0);
+        let shifts = (0..)
+            .map(|k| k as f64 * GRIP_SHIFT_STEP)
+            .take_while(|s| *s <= furthest + 1e-9);
+        for (shift, flip) in shifts.flat_map(|s| [(s, false), (s, true)]) {
+            if !flip && shift > 0.0 && best.is_some() {
+                break;
+            }
+            let pick = grip_pose(&body, piece, &along, shift, flip);
             let in_body = body.inverse() * pick;
             for symmetry in box_symmetries() {
                 let target = piece.target_cell * symmetry;
@@ -277,27 +330,23 @@ impl<'a> WallRun<'a> {
                     // range, that (not its approach above) is the miss to report.
                     solve(self.cell, &pick, &grip, &self.q).map_err(|f| ("pick", f))?;
                     solve(self.cell, &place, &grip, &self.q).map_err(|f| ("place", f))?;
-                    let q_above_pick = solve(self.cell, &raise(&pick, CLEARANCE), &grip, &self.q)
-                        .map_err(|f| ("pick", f))?;
-                    let q_pick = line(
+                    // Descents on a branch that exists all the way down.
+                    let (q_above_pick, q_pick) = continuous_line(
                         self.cell,
-                        &q_above_pick,
+                        &self.q,
                         &raise(&pick, CLEARANCE),
                         &pick,
                         &grip,
-                        5,
+                        LINE_SAMPLES,
                     )
                     .map_err(|f| ("pick", f))?;
-                    let q_above_place =
-                        solve(self.cell, &raise(&place, CLEARANCE), &grip, &q_above_pick)
-                            .map_err(|f| ("place", f))?;
-                    let q_place = line(
+                    let (q_above_place, q_place) = continuous_line(
                         self.cell,
-                        &q_above_place,
+                        &q_above_pick,
                         &raise(&place, CLEARANCE),
                         &place,
                         &grip,
-                        5,
+                        LINE_SAMPLES,
                     )
                     .map_err(|f| ("place", f))?;
                     Ok::<_, (&'static str, IkFailure)>((
@@ -352,14 +401,14 @@ impl<'a> WallRun<'a> {
     }
 }
 
-/// The grip TCP on a piece lying on conveyor 2: on its top face, `offset` back from its
-/// leading end (or at its middle if it is shorter), z down, y along the piece (reversed when
-/// `flip`), x across it (the jaws close along x).
+/// The grip TCP on a piece lying on conveyor 2: on its top face, `shift` from its middle
+/// towards its leading end, z down, y along the piece (reversed when `flip`), x across it (the
+/// jaws close along x).
 fn grip_pose(
     body: &Isometry3<f64>,
     piece: &ScenePiece,
     along_belt: &Vector3<f64>,
-    offset: f64,
+    shift: f64,
     flip: bool,
 ) -> Isometry3<f64> {
     let axes: [Vector3<f64>; 3] = std::array::from_fn(|i| body.rotation * Vector3::ith(i, 1.0));
@@ -375,9 +424,7 @@ fn grip_pose(
         (axes[2], piece.size[2])
     };
     let up = if up_axis.z >= 0.0 { up_axis } else { -up_axis };
-    let length = piece.size[0];
-    let from_centre = (length / 2.0 - offset).max(0.0);
-    let point = body.translation.vector + long * from_centre + up * (height / 2.0);
+    let point = body.translation.vector + long * shift + up * (height / 2.0);
     let z = -up;
     let y = if flip { -long } else { long };
     let x = y.cross(&z);

@@ -20,7 +20,7 @@ pub use nailing::NailPlan;
 use super::SimOptions;
 use super::motion::{JointMove, LinearMove};
 use super::physics::Physics;
-use super::reach::solve;
+use super::reach::{check_step, solve};
 use super::record::{ContactRecord, Operation, WallRecord};
 use crate::cell::{Cell, IkFailure};
 use crate::world::{ScenePiece, SceneWall};
@@ -33,9 +33,6 @@ const CONTACT_TOLERANCE: f64 = 0.001;
 const SURFACE_ON_FLOOR: f64 = 0.005;
 /// How far a framing table reaches beyond the wall laid on it (m).
 const TABLE_BORDER: f64 = 0.05;
-/// Straight-line TCP speed and acceleration.
-pub(super) const LINE_SPEED: f64 = 0.25;
-pub(super) const LINE_ACCEL: f64 = 1.0;
 
 /// The gripped piece: its id, its pose in tool0, its box half sizes.
 #[derive(Debug, Clone)]
@@ -63,6 +60,8 @@ pub struct WallRun<'a> {
     queue: VecDeque<&'a ScenePiece>,
     /// Pieces on the belts (spawned, not yet picked or removed).
     on_belts: BTreeSet<String>,
+    /// Side by side: pieces the transfer has put on conveyor 2.
+    transferred: BTreeSet<String>,
     placed: BTreeMap<String, Isometry3<f64>>,
     record: WallRecord,
     progress: &'a (dyn Fn(usize, usize) + Sync),
@@ -101,6 +100,7 @@ impl<'a> WallRun<'a> {
             contacts: BTreeMap::new(),
             queue: VecDeque::new(),
             on_belts: BTreeSet::new(),
+            transferred: BTreeSet::new(),
             placed: BTreeMap::new(),
             record: WallRecord {
                 wall: wall.id.clone(),
@@ -149,6 +149,20 @@ impl<'a> WallRun<'a> {
 
 // ---- time and physics ----
 impl<'a> WallRun<'a> {
+    /// The programmed speeds (the cell's `[motion]`) scaled by the run's speed fraction.
+    pub(super) fn transfer_speed(&self) -> f64 {
+        self.cell.motion.transfer_speed * self.options.speed
+    }
+    pub(super) fn nailing_speed(&self) -> f64 {
+        self.cell.motion.nailing_speed * self.options.speed
+    }
+    pub(super) fn approach_speed(&self) -> f64 {
+        self.cell.motion.approach_speed * self.options.speed
+    }
+    pub(super) fn nail_approach_speed(&self) -> f64 {
+        self.cell.motion.nail_approach_speed * self.options.speed
+    }
+
     /// One physics step: the robot follows `q`, a held piece follows the tool, the feeder and
     /// the sensor act, contacts are recorded.
     fn step(&mut self) {
@@ -186,7 +200,9 @@ impl<'a> WallRun<'a> {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
         for k in 1..=steps {
             let pose = mv.pose_at(k as f64 * self.options.dt);
-            self.q = solve(self.cell, &pose, tcp, &self.q)?;
+            let next = solve(self.cell, &pose, tcp, &self.q)?;
+            check_step(self.cell, &self.q, &next, k as f64 / steps as f64)?;
+            self.q = next;
             self.step();
         }
         Ok(())

@@ -1,12 +1,13 @@
 //! Nailing: drive every nail of the plan whose plate and member were placed.
 
-use super::{LINE_ACCEL, LINE_SPEED, WallRun, failure_score};
+use super::{WallRun, failure_score};
 use crate::cell::IkFailure;
+use crate::cell::tcp_poses::{nail_pose, nail_rolls, retreat};
 use crate::frame::plan::NailingTarget;
 use crate::sim::motion::LinearMove;
 use crate::sim::reach::{line, solve, touches};
 use crate::sim::record::{NailOutcome, NailRecord, failure_columns};
-use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
 /// The nailer approaches along the nail line from this far back (m).
 pub(super) const NAIL_APPROACH: f64 = 0.10;
@@ -18,7 +19,6 @@ pub(super) const NAIL_DESCENT: f64 = 0.10;
 pub(super) const NAIL_STANDOFF: f64 = 0.01;
 /// Where the nailer fires: its nose this far off the plate's face (m).
 pub(super) const NOSE_GAP: f64 = 0.002;
-pub(super) const FIRE_TIME: f64 = 0.2;
 
 /// One nail as the executor drives it.
 #[derive(Debug, Clone)]
@@ -92,7 +92,9 @@ impl<'a> WallRun<'a> {
             let direction = self.wall_cell.rotation * nail.direction;
             let mut chosen: Option<(Isometry3<f64>, Isometry3<f64>, Vec<f64>)> = None;
             let mut miss: Option<(f64, IkFailure)> = None;
-            let candidates = nail_rolls().into_iter().flat_map(|roll| {
+            let base = Point3::from(self.cell.robot_base.translation.vector);
+            let rolls = nail_rolls(&point, &direction, &base);
+            let candidates = rolls.into_iter().flat_map(|roll| {
                 // The nose stops just short of the face: pressed against the work, the
                 // position-driven tool would shove the loose frame across the floor.
                 let pose = retreat(&nail_pose(&point, &direction, roll), NOSE_GAP);
@@ -130,20 +132,30 @@ impl<'a> WallRun<'a> {
             };
             let plate = nail.plate.clone();
             let start = self.begin(&plate, "nail", &[nail.member.as_str()]);
-            self.move_to(&q_back, &nail_tcp, &[]);
+            self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed());
             let reached = self
                 .run_line(
-                    &LinearMove::new(back, pose, LINE_SPEED, LINE_ACCEL),
+                    &LinearMove::new(
+                        back,
+                        pose,
+                        self.nail_approach_speed(),
+                        self.cell.motion.line_accel,
+                    ),
                     &nail_tcp,
                 )
                 .is_ok();
             let fired_at = self.t;
             if reached {
                 self.phys.nail(&nail.plate, &nail.member);
-                self.wait(FIRE_TIME);
+                self.wait(self.cell.motion.fire_dwell);
             }
             let _ = self.run_line(
-                &LinearMove::new(pose, back, LINE_SPEED, LINE_ACCEL),
+                &LinearMove::new(
+                    pose,
+                    back,
+                    self.nail_approach_speed(),
+                    self.cell.motion.line_accel,
+                ),
                 &nail_tcp,
             );
             self.end(&plate, "nail", start);
@@ -198,19 +210,6 @@ impl<'a> WallRun<'a> {
     }
 }
 
-/// The pose moved back `d` against its z axis (the tool's approach direction).
-fn retreat(pose: &Isometry3<f64>, d: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::from(pose.translation.vector - pose.rotation * Vector3::z() * d),
-        pose.rotation,
-    )
-}
-/// Roll angles about the nail line tried in turn (0: the flange above the nose).
-fn nail_rolls() -> [f64; 6] {
-    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
-    [0.0, FRAC_PI_4, -FRAC_PI_4, FRAC_PI_2, -FRAC_PI_2, PI]
-}
-
 /// Where the nailer starts its straight approach to a nail pose, in the order tried: back
 /// along the nail line, then (for a nail not driven vertically) from above, just off the face.
 fn nail_approaches(pose: Isometry3<f64>) -> impl Iterator<Item = Isometry3<f64>> {
@@ -226,21 +225,4 @@ fn nail_approaches(pose: Isometry3<f64>) -> impl Iterator<Item = Isometry3<f64>>
         )
     });
     std::iter::once(along).chain(from_above)
-}
-
-/// The nail TCP at `point` driving along `direction`, its x axis turned `roll` from up.
-fn nail_pose(point: &Point3<f64>, direction: &Vector3<f64>, roll: f64) -> Isometry3<f64> {
-    let z = direction.normalize();
-    let mut x = Vector3::z() - z * z.z;
-    if x.norm() < 1e-6 {
-        x = Vector3::x() - z * z.x;
-    }
-    let x =
-        UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(z), roll) * x.normalize();
-    let y = z.cross(&x);
-    let rotation = Rotation3::from_basis_unchecked(&[x, y, z]);
-    Isometry3::from_parts(
-        Translation3::from(point.coords),
-        UnitQuaternion::from_rotation_matrix(&rotation),
-    )
 }

@@ -17,11 +17,17 @@ impl<'a> WallRun<'a> {
     /// A collision-checked joint move from the current joints to `to`: straight in joint
     /// space if that is clear, else over the highest of a few raised waypoints that are; if
     /// none is clear, straight (the contacts are then recorded as they happen).
-    pub(super) fn move_to(&mut self, to: &[f64], tcp: &Isometry3<f64>, ignore: &[&str]) {
+    pub(super) fn move_to(
+        &mut self,
+        to: &[f64],
+        tcp: &Isometry3<f64>,
+        ignore: &[&str],
+        speed: f64,
+    ) {
         let from = self.q.clone();
         let path = self.clear_path(&from, to, tcp, ignore);
         for q in path.windows(2) {
-            let mv = JointMove::new(&self.cell.robot, &q[0], &q[1], self.options.speed);
+            let mv = JointMove::new(&self.cell.robot, &q[0], &q[1], speed);
             self.run_joint(&mv);
         }
     }

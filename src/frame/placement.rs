@@ -1,0 +1,230 @@
+//! The placement search behind `offset_x = "auto"`: for every wall and every offset along the
+//! robot's +x from the cell's `assembly_offset_min` to `_max`, which of the wall's pieces the
+//! arm reaches there. The choice itself (most pieces, then nearest the base) is a rule of
+//! `rules/targets.dl`, so `why` shows it; this module only states the reach facts, each with
+//! the offset and the piece it is about.
+//!
+//! A piece counts as reached when its place pose and the pose the gripper descends from both
+//! have an exact IK solution within the joint limits, the gripper pointing down and holding
+//! the piece at its centre of mass (the study's framing target), either way round; a nail
+//! when the nailer's firing pose and the start of its approach along the nail line both
+//! solve, at one of the rolls the executor tries. Every solution counted keeps the arm and
+//! its tool above the floor.
+
+use super::{Facts, FrameError, Reasoned, RuleEngine, reason};
+use crate::cell::tcp_poses::{centre_grip, lowest_point, nail_pose, nail_rolls, retreat};
+use crate::cell::{Cell, OffsetX};
+use crate::logic::{Origin, Value};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use std::collections::BTreeMap;
+
+/// Spacing of the offsets tried (m).
+pub const OFFSET_STEP: f64 = 0.01;
+/// A target counts as reached at an offset only if it is also reached this many steps nearer
+/// and farther (2 cm).
+const ROBUST_STEPS: usize = 2;
+/// Height above the place pose the gripper descends from (m); the executor's clearance.
+pub const APPROACH_HEIGHT: f64 = 0.25;
+/// The nailer approaches a nail along its line from this far back (m), and fires with its
+/// nose this far off the face (m): the executor's numbers.
+const NAIL_APPROACH: f64 = 0.10;
+const NOSE_GAP: f64 = 0.002;
+/// The arm and its tool keep at least this far above the floor (m).
+const FLOOR_CLEARANCE: f64 = 0.002;
+
+/// Adds the placement facts when the cell places walls automatically (a first pass of the
+/// rules gives the pieces' poses with every wall at offset 0). Nothing to add otherwise.
+pub fn add_placement_facts(
+    facts: &mut Facts,
+    cell: &Cell,
+    engine: &RuleEngine,
+) -> Result<(), FrameError> {
+    let OffsetX::Auto { min, max } = cell.assembly.offset_x else {
+        return Ok(());
+    };
+    let first = reason(facts, engine, false)?;
+    facts.extend(placement_facts(cell, &first, min, max));
+    Ok(())
+}
+
+/// The offsets tried: `min` to `max` every OFFSET_STEP, in whole millimetres.
+pub fn candidate_offsets(min: f64, max: f64) -> Vec<f64> {
+    let n = ((max - min) / OFFSET_STEP).floor().max(0.0) as usize;
+    (0..=n)
+        .map(|k| ((min + k as f64 * OFFSET_STEP) * 1000.0).round() / 1000.0)
+        .collect()
+}
+
+/// `placement_candidate(w, x)` for every wall and offset, `placement_reaches(p, x)` for every
+/// piece the arm reaches with its wall at x.
+pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Facts {
+    use rayon::prelude::*;
+    let offsets = candidate_offsets(min, max);
+    let sizes: BTreeMap<&str, [f64; 3]> = first
+        .get("piece_size")
+        .iter()
+        .filter_map(|t| {
+            let p = t.first()?.as_symbol()?;
+            let f = |k: usize| t.get(k).and_then(Value::as_float);
+            Some((p, [f(1)?, f(2)?, f(3)?]))
+        })
+        .collect();
+    let walls: BTreeMap<&str, &str> = first
+        .get("wall_of")
+        .iter()
+        .filter_map(|t| Some((t.first()?.as_symbol()?, t.get(1)?.as_symbol()?)))
+        .collect();
+    let pieces: Vec<(&str, Isometry3<f64>, [f64; 3])> = first
+        .get("placement_target_at_zero")
+        .iter()
+        .filter_map(|t| {
+            let p = t.first()?.as_symbol()?;
+            let Some(Value::Iso(pose)) = t.get(1) else {
+                return None;
+            };
+            Some((p, pose.0, *sizes.get(p)?))
+        })
+        .collect();
+    let reached: Vec<Vec<f64>> = pieces
+        .par_iter()
+        .map(|(_, at_zero, size)| {
+            let ok: Vec<bool> = offsets
+                .iter()
+                .map(|x| reaches(cell, &shifted(at_zero, *x), size))
+                .collect();
+            robustly(&offsets, &ok)
+        })
+        .collect();
+    let nails: Vec<(Vec<Value>, Point3<f64>, Vector3<f64>)> = first
+        .get("placement_nail_at_zero")
+        .iter()
+        .filter_map(|t| {
+            let (Some(Value::Vec3(point)), Some(Value::Vec3(direction))) = (t.get(5), t.get(6))
+            else {
+                return None;
+            };
+            Some((t[..5].to_vec(), Point3::from(point.0), direction.0))
+        })
+        .collect();
+    let nails_reached: Vec<Vec<f64>> = nails
+        .par_iter()
+        .map(|(_, point, direction)| {
+            let ok: Vec<bool> = offsets
+                .iter()
+                .map(|x| nail_reached(cell, &(point + Vector3::new(*x, 0.0, 0.0)), direction))
+                .collect();
+            robustly(&offsets, &ok)
+        })
+        .collect();
+
+    let mut facts = Facts::default();
+    let mut wall_names: Vec<&str> = walls.values().copied().collect();
+    wall_names.sort_unstable();
+    wall_names.dedup();
+    for w in wall_names {
+        for &x in &offsets {
+            facts.add(
+                "placement_candidate",
+                vec![Value::sym(w), Value::float(x)],
+                Origin::Event(format!("placement search: wall {w} tried at x = {x:.3} m")),
+            );
+        }
+    }
+    for ((p, _, _), xs) in pieces.iter().zip(&reached) {
+        for &x in xs {
+            facts.add(
+                "placement_reaches",
+                vec![Value::sym(p), Value::float(x)],
+                Origin::Event(format!(
+                    "placement search: IK solves the place pose of {p} and the pose above it with its wall at x = {x:.3} m"
+                )),
+            );
+        }
+    }
+    for ((key, _, _), xs) in nails.iter().zip(&nails_reached) {
+        for &x in xs {
+            let mut tuple = key.clone();
+            tuple.push(Value::float(x));
+            facts.add(
+                "placement_nail_reaches",
+                tuple,
+                Origin::Event(format!(
+                    "placement search: IK solves the nailer's pose and its approach for a nail of {} into {} with the wall at x = {x:.3} m",
+                    key[0], key[1]
+                )),
+            );
+        }
+    }
+    facts
+}
+
+/// The offsets at which something is reached with ROBUST_STEPS offsets to spare on both sides:
+/// a piece held a little off its planned grip, or a wall a little off its place, still works.
+fn robustly(offsets: &[f64], ok: &[bool]) -> Vec<f64> {
+    (0..offsets.len())
+        .filter(|&i| {
+            let lo = i.saturating_sub(ROBUST_STEPS);
+            let hi = (i + ROBUST_STEPS).min(ok.len() - 1);
+            ok[lo..=hi].iter().all(|b| *b)
+        })
+        .map(|i| offsets[i])
+        .collect()
+}
+
+/// A robot-frame pose moved `x` along the robot's +x.
+fn shifted(pose: &Isometry3<f64>, x: f64) -> Isometry3<f64> {
+    Translation3::new(x, 0.0, 0.0) * pose
+}
+
+/// Whether the arm places a piece whose body frame (robot frame) is `target`, gripping it at
+/// its centre of mass from above, either way round.
+pub fn reaches(cell: &Cell, target: &Isometry3<f64>, size: &[f64; 3]) -> bool {
+    let Some(grip) = cell.tool.tcp("grip") else {
+        return false;
+    };
+    [false, true].into_iter().any(|flip| {
+        let Some(place) = centre_grip(target, size, flip) else {
+            return false;
+        };
+        let above = Translation3::new(0.0, 0.0, APPROACH_HEIGHT) * place;
+        solves_above_floor(cell, &place, grip) && solves_above_floor(cell, &above, grip)
+    })
+}
+
+/// Whether the nailer reaches a nail at `point` (robot frame) driven along `direction`.
+pub fn nail_reached(cell: &Cell, point: &Point3<f64>, direction: &Vector3<f64>) -> bool {
+    let Some(tcp) = cell.tool.tcp("nail") else {
+        return false;
+    };
+    nail_rolls(point, direction, &Point3::origin())
+        .into_iter()
+        .any(|roll| {
+            let fire = retreat(&nail_pose(point, direction, roll), NOSE_GAP);
+            let back = retreat(&fire, NAIL_APPROACH);
+            solves_above_floor(cell, &fire, tcp) && solves_above_floor(cell, &back, tcp)
+        })
+}
+
+/// Whether some exact IK solution of a robot-frame TCP pose keeps the arm and its tool above
+/// the floor.
+fn solves_above_floor(cell: &Cell, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) -> bool {
+    let floor = cell.floor.z - cell.robot_base.translation.z + FLOOR_CLEARANCE;
+    cell.robot
+        .ik(pose, tcp, &cell.robot.home())
+        .is_ok_and(|solutions| {
+            solutions
+                .iter()
+                .any(|q| lowest_point(cell, q) - cell.robot_base.translation.z >= floor)
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_cover_the_range_in_whole_millimetres() {
+        let xs = candidate_offsets(0.5, 0.55);
+        assert_eq!(xs, vec![0.5, 0.51, 0.52, 0.53, 0.54, 0.55]);
+    }
+}
