@@ -4,7 +4,8 @@
 //! comments). Every program runs on the interpreter and must write exactly the
 //! expected files; every program the code generator accepts also runs compiled
 //! (ascent) and must give the same relations. A program whose documented
-//! behaviour is a runtime error lists the error's text in `expected/error`.
+//! behaviour is a runtime error lists the error's text in `expected/error`; one
+//! whose documented behaviour is a warning lists it in `expected/warnings`.
 
 use framewright::logic::compiled::{self, Relations};
 use framewright::logic::front::codegen;
@@ -45,6 +46,7 @@ fn expected(prog: &Path) -> BTreeMap<String, String> {
 /// input relations it read, and every relation; or the error.
 struct Interpreted {
     files: BTreeMap<String, String>,
+    warnings: Vec<String>,
     edb: Relations,
     all: Relations,
 }
@@ -60,7 +62,7 @@ fn interpret(program: &Arc<Program>, facts: &Path) -> Result<Interpreted, LogicE
         .filter(|r| r.input.is_some())
         .map(|r| (r.name.clone(), engine.relation(&r.name).unwrap()))
         .collect();
-    engine.run()?;
+    let warnings = engine.run()?.warnings;
     let out = tempfile::tempdir().unwrap();
     let (written, stdout) = io::write_outputs(&engine, out.path())?;
     let mut files: BTreeMap<String, String> = written
@@ -80,7 +82,12 @@ fn interpret(program: &Arc<Program>, facts: &Path) -> Result<Interpreted, LogicE
         .iter()
         .map(|r| (r.name.clone(), engine.relation(&r.name).unwrap()))
         .collect();
-    Ok(Interpreted { files, edb, all })
+    Ok(Interpreted {
+        files,
+        warnings,
+        edb,
+        all,
+    })
 }
 
 /// The input relations as the interpreter reads them (for the compiled run of
@@ -119,6 +126,7 @@ fn corpus_programs_give_their_documented_outputs_on_both_engines() {
         let facts = prog.with_extension("");
         let mut want = expected(prog);
         let want_error = want.remove("error");
+        let want_warnings = want.remove("warnings").unwrap_or_default();
         let interpreted = interpret(&program, &facts);
         let compiled = compiled::program(&rel);
         // build.rs compiles exactly the programs the generator accepts.
@@ -142,6 +150,16 @@ fn corpus_programs_give_their_documented_outputs_on_both_engines() {
             (Some(_), Ok(_)) => panic!("{rel}: the run should have failed"),
             (None, Err(e)) => panic!("{rel}: {e}"),
             (None, Ok(got)) => {
+                let warnings = got.warnings.join("\n");
+                for line in want_warnings.lines() {
+                    assert!(
+                        warnings.contains(line),
+                        "{rel}: expected the warning `{line}`, got:\n{warnings}"
+                    );
+                }
+                if want_warnings.is_empty() {
+                    assert!(got.warnings.is_empty(), "{rel}: warnings {warnings}");
+                }
                 assert_eq!(
                     got.files.keys().collect::<Vec<_>>(),
                     want.keys().collect::<Vec<_>>(),

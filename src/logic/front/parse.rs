@@ -118,6 +118,7 @@ impl<'a> Parser<'a> {
             Tok::Ident(s) => format!("`{s}`"),
             Tok::Directive(s) => format!("`.{s}`"),
             Tok::Int(i) => format!("`{i}`"),
+            Tok::UInt(i) => format!("`{i}u`"),
             Tok::Float(f) => format!("`{f}`"),
             Tok::Str(s) => format!("\"{s}\""),
             Tok::P(p) => format!("`{p}`"),
@@ -735,6 +736,14 @@ impl<'a> Parser<'a> {
             Tok::Int(i) => {
                 self.bump();
                 Ok(e(ExprKind::Int(i)))
+            }
+            Tok::UInt(i) => {
+                // An unsigned constant: the integer converted to unsigned.
+                self.bump();
+                Ok(e(ExprKind::Builtin(
+                    Builtin::Itou,
+                    vec![e(ExprKind::Int(i))],
+                )))
             }
             Tok::Float(f) => {
                 self.bump();
