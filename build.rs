@@ -1,5 +1,6 @@
 //! Compiles the built-in rule base (all `rules/*.dl` as one program, entry
-//! `"rules"`) and each `tests/logic/*.dl` and `benches/logic/*.dl` into ascent programs in `OUT_DIR/logic_compiled.rs`,
+//! `"rules"`), each `tests/logic/*.dl` and `benches/logic/*.dl`, and every program of the
+//! Soufflé corpus `tests/fixtures/souffle/*.dl` that the generator accepts into ascent programs in `OUT_DIR/logic_compiled.rs`,
 //! using the same parser and checker as the interpreter.
 
 use std::fmt::Write as _;
@@ -53,6 +54,9 @@ macro_rules! functor_table {
 }
 include!("src/logic/functor_defs.rs");
 
+/// Programs written for Soufflé with their documented outputs.
+const SOUFFLE_CORPUS: &str = "tests/fixtures/souffle";
+
 fn dl_files(dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|rd| {
@@ -72,7 +76,7 @@ fn main() {
     println!("cargo:rerun-if-changed=src/logic/functor_defs.rs");
     let mut out = String::new();
     let mut table = Vec::new();
-    for dir in ["rules", "tests/logic", "benches/logic"] {
+    for dir in ["rules", "tests/logic", "benches/logic", SOUFFLE_CORPUS] {
         println!("cargo:rerun-if-changed={dir}");
         // Included fragments live in subdirectories; watch them too.
         if let Ok(rd) = std::fs::read_dir(root.join(dir)) {
@@ -117,6 +121,22 @@ fn main() {
                 Ok(code) => out.push_str(&code),
                 Err(e) => panic!("rule program {rel} cannot be compiled to ascent: {e}"),
             }
+            table.push((rel, module));
+        }
+    }
+    // The Soufflé compatibility corpus: every program the code generator
+    // accepts (tests/souffle_corpus.rs checks which ones it refuses, and why).
+    for file in dl_files(&root.join(SOUFFLE_CORPUS)) {
+        let rel = format!(
+            "{SOUFFLE_CORPUS}/{}",
+            file.file_name().unwrap().to_string_lossy()
+        );
+        let Ok(program) = front::load_files(std::slice::from_ref(&file), SIGS) else {
+            continue;
+        };
+        let module = rel.trim_end_matches(".dl").replace(['/', '.', '-'], "_");
+        if let Ok(code) = front::codegen::generate(&program, &module) {
+            out.push_str(&code);
             table.push((rel, module));
         }
     }

@@ -151,7 +151,12 @@ fn unsupported_soufflé_features_are_named() {
     fails(".init c = C\n", 4, 1, "component instances");
     fails("p(x, y) <= p(x, z) :- y < z.\n", 4, 9, "subsumption");
     fails(".decl c(x: number) choice-domain x\n", 4, 20, "choice");
-    fails(".type U = number | symbol\n", 4, 18, "union types");
+    fails(
+        ".type U = number | symbol\n",
+        4,
+        7,
+        "union type `U` mixes number and symbol members",
+    );
     fails(
         ".functor f(number): number\n",
         4,
@@ -159,8 +164,24 @@ fn unsupported_soufflé_features_are_named() {
         "user-defined functors",
     );
     fails("p(x, y) :- e(x, y), x = $.\n", 4, 25, "`$`");
-    fails(".decl q(x: number) eqrel\n", 4, 20, "eqrel");
+    fails(
+        ".decl q(x: number) eqrel\n",
+        4,
+        20,
+        "an `eqrel` relation has two attributes",
+    );
     fails("p(x, y) :- e(x, y), x = y band 1.\n", 4, 27, "bitwise");
+}
+
+#[test]
+fn an_aggregate_cannot_export_a_binding() {
+    // The witness problem, as Soufflé's aggregate documentation describes it.
+    fails(
+        ".decl family(name: symbol, age: number)\n.decl youngest(name: symbol, age: number)\nyoungest(p, n) :- n = min x : family(p, x).\n",
+        6,
+        21,
+        "variable `p` is grounded only inside the aggregate",
+    );
 }
 
 #[test]

@@ -77,7 +77,9 @@ pub fn run(cmd: RulesCommand) -> CmdResult {
             };
             let mut engine = Engine::new(p, options);
             io::load_inputs(&mut engine, &facts)?;
-            engine.run()?;
+            for w in engine.run()?.warnings {
+                eprintln!("warning: {w}");
+            }
             let mut report = String::new();
             for (negated, (rel, tuple)) in &queries {
                 if *negated {

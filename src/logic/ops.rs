@@ -115,22 +115,41 @@ pub fn contains(needle: &str, hay: &str) -> bool {
     hay.contains(needle)
 }
 
-/// Whole-string regular-expression match (like `std::regex_match`).
+thread_local! {
+    /// Warnings of the current run on this thread (sorted, each once).
+    static WARNINGS: RefCell<std::collections::BTreeSet<String>> = const { RefCell::new(std::collections::BTreeSet::new()) };
+}
+
+/// Take the warnings recorded on this thread since the last call.
+pub fn take_warnings() -> Vec<String> {
+    WARNINGS.with(|w| std::mem::take(&mut *w.borrow_mut()).into_iter().collect())
+}
+
+/// Whole-string regular-expression match (like `std::regex_match`). A
+/// pattern that is not a valid regular expression matches nothing and leaves
+/// a warning, as Soufflé documents ("wrong pattern provided for match").
 pub fn regex_match(pattern: &str, text: &str) -> OpResult<bool> {
     thread_local! {
-        static CACHE: RefCell<HashMap<String, regex::Regex>> = RefCell::new(HashMap::new());
+        static CACHE: RefCell<HashMap<String, Option<regex::Regex>>> = RefCell::new(HashMap::new());
     }
     CACHE.with(|c| {
         let mut c = c.borrow_mut();
         if !c.contains_key(pattern) {
-            let re = regex::Regex::new(&format!("^(?:{pattern})$"))
-                .map_err(|e| format!("match: bad regular expression {pattern:?}: {e}"))?;
+            let re = regex::Regex::new(&format!("^(?:{pattern})$"));
+            if let Err(e) = &re {
+                let first = e.to_string().lines().last().unwrap_or_default().to_string();
+                WARNINGS.with(|w| {
+                    w.borrow_mut().insert(format!(
+                        "wrong pattern provided for match({pattern:?}, ...): {first}; it matches nothing"
+                    ))
+                });
+            }
             if c.len() > 1024 {
                 c.clear();
             }
-            c.insert(pattern.to_string(), re);
+            c.insert(pattern.to_string(), re.ok());
         }
-        Ok(c[pattern].is_match(text))
+        Ok(c[pattern].as_ref().is_some_and(|re| re.is_match(text)))
     })
 }
 
@@ -167,7 +186,8 @@ mod tests {
         assert!(substr("hello", 6, 1).is_err());
         assert!(regex_match("a.*c", "abc").unwrap());
         assert!(!regex_match("b", "abc").unwrap());
-        assert!(regex_match("(", "x").is_err());
+        assert!(!regex_match("(", "x").unwrap());
+        assert_eq!(take_warnings().len(), 1);
         assert_eq!(to_number(" 42 ").unwrap(), 42);
         assert!(to_number("4x").is_err());
     }

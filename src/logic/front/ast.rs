@@ -330,12 +330,16 @@ impl RelDecl {
     }
 }
 
-/// A user type: `.type T <: base` (subtype) or `.type T = other` (alias).
+/// A user type: `.type T <: base` (subtype), `.type T = other` (alias) or
+/// `.type T = A | B | ...` (union: every member is a subtype of `T`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TypeDecl {
     pub name: String,
+    /// The parent type; for a union, its first member.
     pub parent: String,
     pub is_subtype: bool,
+    /// The members of a union type (empty otherwise).
+    pub members: Vec<String>,
     pub span: Span,
 }
 

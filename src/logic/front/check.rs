@@ -185,20 +185,42 @@ impl Checker<'_> {
         None
     }
 
-    /// The chain `name, parent, grandparent, …, base` with aliases collapsed.
-    fn ancestors(&self, name: &str) -> Vec<String> {
-        let mut out = Vec::new();
+    /// `name` with aliases (`.type T = U`) followed to the type they name.
+    fn canonical(&self, name: &str) -> String {
         let mut cur = name.to_string();
         for _ in 0..64 {
             match self.types.get(&cur) {
-                Some(t) if !t.is_subtype => cur = t.parent.clone(),
-                Some(t) => {
-                    out.push(cur.clone());
-                    cur = t.parent.clone();
+                Some(t) if !t.is_subtype && t.members.is_empty() => cur = t.parent.clone(),
+                _ => break,
+            }
+        }
+        cur
+    }
+
+    /// Every type a value of `name` also has, `name` (alias-collapsed) first:
+    /// its parents up to the primitive type and every union containing one of them.
+    fn ancestors(&self, name: &str) -> Vec<String> {
+        let first = self.canonical(name);
+        let mut out = vec![first.clone()];
+        let mut todo = vec![first];
+        while let Some(t) = todo.pop() {
+            let mut sup = Vec::new();
+            match self.types.get(&t) {
+                Some(d) if !d.members.is_empty() => {
+                    sup.extend(self.resolve_type(&t).map(|b| b.name().to_string()))
                 }
-                None => {
-                    out.push(cur);
-                    break;
+                Some(d) if d.is_subtype => sup.push(self.canonical(&d.parent)),
+                _ => {}
+            }
+            for (u, d) in &self.types {
+                if d.members.iter().any(|m| self.canonical(m) == t) {
+                    sup.push(u.clone());
+                }
+            }
+            for x in sup {
+                if !out.contains(&x) {
+                    out.push(x.clone());
+                    todo.push(x);
                 }
             }
         }
@@ -226,11 +248,38 @@ impl Checker<'_> {
                 self.error(t.span, format!("type `{}` does not resolve to a primitive type (unknown parent `{}` or a cycle)", t.name, t.parent), "types derive from number, unsigned, float, symbol, vec3, iso or box");
             }
         }
+        for t in type_list.iter().filter(|t| !t.members.is_empty()) {
+            let base = self.resolve_type(&t.name);
+            for m in &t.members {
+                let mb = self.resolve_type(m);
+                if mb.is_none() {
+                    self.error(
+                        t.span,
+                        format!("union type `{}`: unknown member type `{m}`", t.name),
+                        "declare the member type with `.type`",
+                    );
+                } else if mb != base {
+                    self.error(
+                        t.span,
+                        format!(
+                            "union type `{}` mixes {} and {} members",
+                            t.name,
+                            base.map_or("?", |b| b.name()),
+                            mb.map_or("?", |b| b.name())
+                        ),
+                        "the members of a union must all derive from the same primitive type",
+                    );
+                }
+            }
+        }
         // Relations.
         let mut relations: Vec<RelDecl> = Vec::new();
         let mut rel_index: BTreeMap<String, usize> = BTreeMap::new();
         for (_, item) in &items {
-            if let Item::Decl { name, attrs, span } = item {
+            if let Item::Decl {
+                name, attrs, span, ..
+            } = item
+            {
                 if let Some(&prev) = rel_index.get(name) {
                     let prev_loc = self.loc(relations[prev].span);
                     self.error(
@@ -343,6 +392,18 @@ impl Checker<'_> {
                 }
             }
         }
+        let items_eqrel: Vec<(String, Span)> = items
+            .iter()
+            .filter_map(|(_, item)| match item {
+                Item::Decl {
+                    name,
+                    eqrel: true,
+                    span,
+                    ..
+                } if rel_index.contains_key(name) => Some((name.clone(), *span)),
+                _ => None,
+            })
+            .collect();
         // Clauses.
         let mut rules = Vec::new();
         let mut labels: BTreeMap<String, Span> = BTreeMap::new();
@@ -361,6 +422,23 @@ impl Checker<'_> {
                     }
                     labels.insert(l.clone(), rule.span);
                 }
+                if self.check_rule(&mut rule, &relations, &rel_index) {
+                    rules.push(rule);
+                }
+            }
+        }
+        // `eqrel`: the reflexive, symmetric and transitive closure, as rules
+        // (what Soufflé's documentation says an eqrel relation holds).
+        for (name, span) in items_eqrel {
+            if relations[rel_index[&name]].attrs[0].ty != relations[rel_index[&name]].attrs[1].ty {
+                self.error(
+                    span,
+                    format!("the two attributes of `eqrel` relation `{name}` have different types"),
+                    "give both attributes the same type",
+                );
+                continue;
+            }
+            for mut rule in eqrel_rules(&name, span) {
                 if self.check_rule(&mut rule, &relations, &rel_index) {
                     rules.push(rule);
                 }
@@ -623,7 +701,8 @@ impl Checker<'_> {
                         self.error(e.span, format!("type mismatch: `{v}` has type `{}` here but `{prev_name}` elsewhere, and neither is a subtype of the other", attr.ty_name), "subtypes of the same base type are distinct; use one declared type for both attributes");
                         continue;
                     }
-                    if anc_new.len() > anc_old.len() {
+                    // Keep the narrower of the two types.
+                    if anc_new.contains(&anc_old[0]) {
                         named.insert(v.clone(), (attr.ty_name.clone(), e.span));
                     }
                 } else {
@@ -722,6 +801,53 @@ impl Checker<'_> {
         self.error(span, format!("type mismatch: {what} is a {found} but a {expected} is expected here"), "convert explicitly (itof, ftoi, itou, utoi, to_string, to_number) or fix the attribute type");
     }
 
+    /// Soufflé's overloads, resolved by operand type: `to_number`, `to_float`
+    /// and `to_unsigned` convert between the number types too (not only from
+    /// symbols), and `+` on two symbols concatenates them.
+    fn resolve_overload(&self, e: &Expr, expected: Option<BaseTy>, env: &Env) -> Option<Expr> {
+        use BaseTy::*;
+        match &e.kind {
+            ExprKind::Builtin(
+                b @ (Builtin::ToNumber | Builtin::ToFloat | Builtin::ToUnsigned),
+                args,
+            ) if args.len() == 1 => {
+                let arg = &args[0];
+                let from = self
+                    .peek_type(arg, env)
+                    .or_else(|| is_int_const(arg).then_some(Number))?;
+                let to = match b {
+                    Builtin::ToNumber => Number,
+                    Builtin::ToFloat => Float,
+                    _ => Unsigned,
+                };
+                let conv = match (from, to) {
+                    (a, b) if a == b => return Some(arg.clone()),
+                    (Number, Float) => Builtin::Itof,
+                    (Number, Unsigned) => Builtin::Itou,
+                    (Unsigned, Number) => Builtin::Utoi,
+                    (Unsigned, Float) => Builtin::Utof,
+                    (Float, Number) => Builtin::Ftoi,
+                    (Float, Unsigned) => Builtin::Ftou,
+                    _ => return None,
+                };
+                Some(Expr {
+                    kind: ExprKind::Builtin(conv, args.clone()),
+                    ..e.clone()
+                })
+            }
+            ExprKind::Bin(BinOp::Add, a, b) => {
+                let symbolic = expected == Some(Symbol)
+                    || self.peek_type(a, env) == Some(Symbol)
+                    || self.peek_type(b, env) == Some(Symbol);
+                symbolic.then(|| Expr {
+                    kind: ExprKind::Builtin(Builtin::Cat, vec![(**a).clone(), (**b).clone()]),
+                    ..e.clone()
+                })
+            }
+            _ => None,
+        }
+    }
+
     /// Type-check `e` against `expected` (if any) and record its type.
     fn check_expr(
         &mut self,
@@ -729,6 +855,9 @@ impl Checker<'_> {
         expected: Option<BaseTy>,
         env: &mut Env,
     ) -> Option<BaseTy> {
+        if let Some(rewritten) = self.resolve_overload(e, expected, env) {
+            *e = rewritten;
+        }
         let span = e.span;
         let ty = match &mut e.kind {
             ExprKind::Var(v) => match (env.get(v).copied(), expected) {
@@ -1083,6 +1212,22 @@ impl Checker<'_> {
             // Nothing can run: report the first unbound variable.
             let i = remaining[0];
             let lit = &body[i];
+            // An aggregate reads a variable that only its own body could bind:
+            // the value cannot leave the aggregate (Soufflé's witness problem).
+            if let Literal::Cmp(_, a, b, _) = lit {
+                let witness = [a, b].into_iter().find_map(|e| match &e.kind {
+                    ExprKind::Agg(g) => g.injected.iter().find(|v| !bound.contains(*v)).cloned(),
+                    _ => None,
+                });
+                if let Some(v) = witness {
+                    self.error(
+                        lit.span(),
+                        format!("variable `{v}` is grounded only inside the aggregate but used outside it (the witness problem: an aggregate cannot export a binding)"),
+                        format!("bind `{v}` in a positive atom outside the aggregate, or use a fresh variable inside it"),
+                    );
+                    return None;
+                }
+            }
             let unbound: Vec<String> = lit_free_vars(lit)
                 .into_iter()
                 .filter(|v| !bound.contains(v))
@@ -1294,6 +1439,42 @@ fn cycle_path(
         path.push(to);
     }
     path
+}
+
+/// The rules that make `rel` an equivalence relation:
+/// `rel(x, x) :- rel(x, _).`, `rel(y, x) :- rel(x, y).`,
+/// `rel(x, z) :- rel(x, y), rel(y, z).` (cited at the declaration).
+fn eqrel_rules(rel: &str, span: Span) -> Vec<Rule> {
+    let v = |n: &str| Expr {
+        kind: if n == "_" {
+            ExprKind::Wild
+        } else {
+            ExprKind::Var(n.to_string())
+        },
+        span,
+        ty: None,
+    };
+    let atom = |a: &str, b: &str| Atom {
+        rel: rel.to_string(),
+        args: vec![v(a), v(b)],
+        span,
+    };
+    let rule = |head: Atom, body: Vec<Atom>, what: &str| Rule {
+        head,
+        body: body.into_iter().map(Literal::Pos).collect(),
+        plan: Vec::new(),
+        label: Some(format!("eqrel_{what}({rel})")),
+        span,
+    };
+    vec![
+        rule(atom("x", "x"), vec![atom("x", "_")], "reflexive"),
+        rule(atom("y", "x"), vec![atom("x", "y")], "symmetric"),
+        rule(
+            atom("x", "z"),
+            vec![atom("x", "y"), atom("y", "z")],
+            "transitive",
+        ),
+    ]
 }
 
 /// The step a literal can take now, if all it reads is bound.

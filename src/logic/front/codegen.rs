@@ -41,6 +41,8 @@ struct Gen<'p> {
     aux_decls: Vec<String>,
     aux_rules: Vec<String>,
     fresh: usize,
+    /// The rule being generated derives a relation of a recursive stratum.
+    head_recursive: bool,
 }
 
 /// One rule being written: its clauses and the variables bound so far.
@@ -56,6 +58,7 @@ pub fn generate(prog: &Program, module: &str) -> Result<String, String> {
         aux_decls: Vec::new(),
         aux_rules: Vec::new(),
         fresh: 0,
+        head_recursive: false,
     };
     let mut rules_text = String::new();
     for (i, rule) in prog.rules.iter().enumerate() {
@@ -172,6 +175,12 @@ impl Gen<'_> {
     }
 
     fn rule(&mut self, id: usize, rule: &Rule) -> Result<String, String> {
+        let head = self.prog.rel_index[&rule.head.rel];
+        self.head_recursive = self
+            .prog
+            .strata
+            .iter()
+            .any(|s| s.recursive && s.relations.contains(&head));
         let mut types = BTreeMap::new();
         for a in &rule.head.args {
             collect_var_types(a, &mut types);
@@ -422,15 +431,20 @@ impl Gen<'_> {
                 }
             }
         }
-        if !deferred.is_empty() {
-            return Err("the compiled engine needs every outer variable of an aggregate to occur in a positive atom of its body".into());
-        }
-        for v in &injected {
-            if !inner.bound.contains(v) {
-                return Err(format!(
-                    "the compiled engine needs the aggregate's outer variable `{v}` to occur in a positive atom of its body"
-                ));
+        if !deferred.is_empty() || injected.iter().any(|v| !inner.bound.contains(v)) {
+            // The body alone does not bind the outer variables (`y < n` with `n`
+            // from outside): evaluate it after the outer literals that bind them.
+            // In a recursive stratum that would aggregate over the head's own
+            // stratum, which ascent refuses.
+            if self.head_recursive {
+                return Err("in a recursive rule the compiled engine needs every outer variable of an aggregate to occur in a positive atom of its body".into());
             }
+            inner = Body {
+                clauses: b.clauses.clone(),
+                bound: b.bound.clone(),
+                rule_name: b.rule_name.clone(),
+            };
+            self.steps(&lits, &g.plan, &mut inner)?;
         }
         let name = self.fresh("agg");
         let mut cols: Vec<&str> = injected.iter().map(|v| rust_ty(types[v])).collect();

@@ -9,6 +9,8 @@ pub enum Tok {
     /// `.name` at the start of a directive (`.decl`, `.input`, ...).
     Directive(String),
     Int(i128),
+    /// An unsigned constant written with Soufflé's `u` suffix (`10u`).
+    UInt(i128),
     Float(f64),
     Str(String),
     /// Punctuation and operators, as written (`:-`, `<=`, `(`, ...).
@@ -221,6 +223,15 @@ pub fn lex(file: u32, text: &str) -> Result<(Vec<Token>, Vec<Label>), LexError> 
                 }
             }
             let text: String = chars[digits_start..j].iter().collect();
+            // `10u`: Soufflé's unsigned constant.
+            let unsigned = !is_float
+                && chars.get(j) == Some(&'u')
+                && !chars
+                    .get(j + 1)
+                    .is_some_and(|c| c.is_alphanumeric() || *c == '_');
+            if unsigned {
+                j += 1;
+            }
             let sp = span(line, col, j - i);
             let tok = if is_float {
                 Tok::Float(text.parse().map_err(|_| LexError {
@@ -229,11 +240,16 @@ pub fn lex(file: u32, text: &str) -> Result<(Vec<Token>, Vec<Label>), LexError> 
                     hint: "write floats as `1.5` or `2.0e3`".into(),
                 })?)
             } else {
-                Tok::Int(i128::from_str_radix(&text, radix).map_err(|_| LexError {
+                let value = i128::from_str_radix(&text, radix).map_err(|_| LexError {
                     span: sp,
                     message: format!("bad integer literal `{text}`"),
                     hint: "integers must fit in 64 bits".into(),
-                })?)
+                })?;
+                if unsigned {
+                    Tok::UInt(value)
+                } else {
+                    Tok::Int(value)
+                }
             };
             toks.push(Token { tok, span: sp });
             advance(j - i, &mut i, &mut col);

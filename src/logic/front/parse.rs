@@ -30,6 +30,8 @@ pub enum Item {
     Decl {
         name: String,
         attrs: Vec<(String, String, Span)>,
+        /// Declared `eqrel`: the relation is an equivalence relation.
+        eqrel: bool,
         span: Span,
     },
     Io {
@@ -116,6 +118,7 @@ impl<'a> Parser<'a> {
             Tok::Ident(s) => format!("`{s}`"),
             Tok::Directive(s) => format!("`.{s}`"),
             Tok::Int(i) => format!("`{i}`"),
+            Tok::UInt(i) => format!("`{i}u`"),
             Tok::Float(f) => format!("`{f}`"),
             Tok::Str(s) => format!("\"{s}\""),
             Tok::P(p) => format!("`{p}`"),
@@ -189,11 +192,18 @@ impl<'a> Parser<'a> {
                         );
                     }
                     if self.is("|") {
-                        return err(
-                            self.span(),
-                            "union types (`.type T = A | B`) are not supported",
-                            "use a common supertype: declare both as subtypes (`<:`) of `number` or `symbol`",
-                        );
+                        let mut members = vec![p.clone()];
+                        while self.eat("|") {
+                            members.push(self.ident("a type name")?.0);
+                        }
+                        items.push(Item::Type(TypeDecl {
+                            name,
+                            parent: p,
+                            is_subtype: false,
+                            members,
+                            span: nspan,
+                        }));
+                        return Ok(());
                     }
                     (p, false)
                 } else {
@@ -207,11 +217,16 @@ impl<'a> Parser<'a> {
                     name,
                     parent,
                     is_subtype,
+                    members: Vec::new(),
                     span: nspan,
                 }));
             }
             "decl" => {
-                let (name, nspan) = self.ident("a relation name")?;
+                // `.decl a, b(x: number)` declares several relations alike.
+                let mut names = vec![self.ident("a relation name")?];
+                while self.eat(",") {
+                    names.push(self.ident("a relation name")?);
+                }
                 self.expect(
                     "(",
                     "a declaration looks like `.decl edge(x: number, y: number)`",
@@ -238,6 +253,7 @@ impl<'a> Parser<'a> {
                 self.expect(")", "close the attribute list with `)`")?;
                 // Qualifiers: storage hints are accepted and ignored; the ones that
                 // change meaning are refused by name.
+                let mut eqrel = false;
                 loop {
                     match self.peek().clone() {
                         Tok::Ident(q)
@@ -256,11 +272,19 @@ impl<'a> Parser<'a> {
                             self.bump();
                         }
                         Tok::Ident(q) if q == "eqrel" => {
-                            return err(
-                                self.span(),
-                                "equivalence relations (`eqrel`) are not supported",
-                                "remove `eqrel` and write the reflexive, symmetric and transitive rules explicitly",
-                            );
+                            if attrs.len() != 2 {
+                                return err(
+                                    self.span(),
+                                    format!(
+                                        "an `eqrel` relation has two attributes; `{}` has {}",
+                                        names[0].0,
+                                        attrs.len()
+                                    ),
+                                    "declare it as `.decl r(x: T, y: T) eqrel`",
+                                );
+                            }
+                            eqrel = true;
+                            self.bump();
                         }
                         Tok::Ident(q) if q == "choice" => {
                             return err(
@@ -273,17 +297,20 @@ impl<'a> Parser<'a> {
                             return err(
                                 self.span(),
                                 format!("the `{q}` qualifier is not supported"),
-                                format!("use a separate `.{q} {name}` directive"),
+                                format!("use a separate `.{q} {}` directive", names[0].0),
                             );
                         }
                         _ => break,
                     }
                 }
-                items.push(Item::Decl {
-                    name,
-                    attrs,
-                    span: nspan,
-                });
+                for (name, nspan) in names {
+                    items.push(Item::Decl {
+                        name,
+                        attrs: attrs.clone(),
+                        eqrel,
+                        span: nspan,
+                    });
+                }
             }
             "input" | "output" => {
                 let mut rels = vec![self.ident("a relation name")?];
@@ -291,29 +318,32 @@ impl<'a> Parser<'a> {
                     rels.push(self.ident("a relation name")?);
                 }
                 let mut params = Vec::new();
+                // `.output r()` (an empty parameter list) is how Soufflé's docs write it.
                 if self.eat("(") {
-                    loop {
-                        let (k, kspan) =
-                            self.ident("a parameter name (IO, filename, delimiter)")?;
-                        self.expect("=", "parameters look like `filename=\"x.facts\"`")?;
-                        let v = match self.peek().clone() {
-                            Tok::Str(s) => s,
-                            Tok::Ident(s) => s,
-                            other => {
-                                return err(
-                                    self.span(),
-                                    format!(
-                                        "expected a parameter value, found {}",
-                                        Self::describe(&other)
-                                    ),
-                                    "write the value as a string: `delimiter=\",\"`",
-                                );
+                    if !self.is(")") {
+                        loop {
+                            let (k, kspan) =
+                                self.ident("a parameter name (IO, filename, delimiter)")?;
+                            self.expect("=", "parameters look like `filename=\"x.facts\"`")?;
+                            let v = match self.peek().clone() {
+                                Tok::Str(s) => s,
+                                Tok::Ident(s) => s,
+                                other => {
+                                    return err(
+                                        self.span(),
+                                        format!(
+                                            "expected a parameter value, found {}",
+                                            Self::describe(&other)
+                                        ),
+                                        "write the value as a string: `delimiter=\",\"`",
+                                    );
+                                }
+                            };
+                            self.bump();
+                            params.push((k, v, kspan));
+                            if !self.eat(",") {
+                                break;
                             }
-                        };
-                        self.bump();
-                        params.push((k, v, kspan));
-                        if !self.eat(",") {
-                            break;
                         }
                     }
                     self.expect(")", "close the parameter list with `)`")?;
@@ -706,6 +736,14 @@ impl<'a> Parser<'a> {
             Tok::Int(i) => {
                 self.bump();
                 Ok(e(ExprKind::Int(i)))
+            }
+            Tok::UInt(i) => {
+                // An unsigned constant: the integer converted to unsigned.
+                self.bump();
+                Ok(e(ExprKind::Builtin(
+                    Builtin::Itou,
+                    vec![e(ExprKind::Int(i))],
+                )))
             }
             Tok::Float(f) => {
                 self.bump();

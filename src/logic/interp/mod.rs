@@ -85,6 +85,9 @@ pub struct Options {
 pub struct RunStats {
     pub iterations: usize,
     pub tuples: usize,
+    /// Problems that did not stop the run (a `match` pattern that is not a
+    /// regular expression), each once, sorted.
+    pub warnings: Vec<String>,
 }
 
 pub struct Engine {
@@ -208,6 +211,7 @@ impl Engine {
         }
         self.ran = true;
         let mut stats = RunStats::default();
+        let _ = super::ops::take_warnings();
         let strata = std::mem::take(&mut self.strata);
         let result = (|| -> Result<(), LogicError> {
             for (si, rules) in strata.iter().enumerate() {
@@ -216,6 +220,7 @@ impl Engine {
             Ok(())
         })();
         self.strata = strata;
+        stats.warnings = super::ops::take_warnings();
         result?;
         stats.tuples = self.rels.iter().map(Relation::len).sum();
         Ok(stats)
