@@ -1,0 +1,16 @@
+//! Back into BIM tools: what framewright inferred, written where authoring and
+//! coordination tools read it.
+//!
+//! - `annotate`: the input IFC with property sets, the assembly sequence as
+//!   processes (IfcWorkSchedule, IfcTask, IfcRelSequence) and the nails as
+//!   IfcMechanicalFastener appended; the input's entities are kept byte for byte.
+//! - `step_edit`: the byte-level edit of a STEP file (header record, appended entities).
+
+pub mod annotate;
+mod error;
+pub mod step_edit;
+mod verdicts;
+
+pub use annotate::{AnnotateOptions, Annotated, ElementVerdict, NailSize, PSET_NAME, annotate};
+pub use error::AnnotateError;
+pub use verdicts::element_verdicts;
