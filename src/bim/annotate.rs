@@ -120,7 +120,7 @@ fn text_attr(file: &StepFile, id: u64, i: usize) -> Option<String> {
 }
 
 /// Is `text` (its first 19 characters) an ISO 8601 date-time `YYYY-MM-DDThh:mm:ss`?
-fn iso_date_time(text: &str) -> Option<&str> {
+pub fn iso_date_time(text: &str) -> Option<&str> {
     let head = text.get(..19)?;
     let ok = head.bytes().enumerate().all(|(i, c)| match i {
         4 | 7 => c == b'-',

@@ -2,6 +2,7 @@
 //! message shown to the user and the exit code (2 = bad input).
 
 pub mod annotate;
+pub mod bcf;
 pub mod check;
 pub mod inspect;
 pub mod plan;

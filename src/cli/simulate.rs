@@ -40,6 +40,8 @@ pub struct SimulateArgs {
     /// Fraction of the robot's joint speed and acceleration limits to move at (0..1].
     #[arg(long, default_value_t = 1.0)]
     pub speed: f64,
+    #[command(flatten)]
+    pub bcf: super::bcf::BcfArgs,
 }
 
 pub fn run(args: SimulateArgs) -> CmdResult {
@@ -67,6 +69,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         bars.update(wall, done, total)
     })?;
     bars.finish();
+    args.bcf.write(&model, &sim)?;
     let mut report = SimReport::new(&sim, options.dt);
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
