@@ -337,3 +337,81 @@ fn ifcopenshell_validates_and_finds_the_plan() {
         );
     }
 }
+
+/// With --simulate each element's property set carries its verdicts as `simulate --json`
+/// reports them.
+#[test]
+fn simulate_verdicts_agree_with_the_simulate_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = root().join("examples/models/tm1.ifc");
+    let out = dir.path().join("out.ifc");
+    let output = annotate(&model, &out, &["--simulate"]);
+    let report = framewright(&["simulate", model.to_str().unwrap(), "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&report.stdout).unwrap();
+    let f = read(&output);
+    // Property name → value text, per element GlobalId (one-piece products here).
+    let text = |id: u64, i: usize| -> String {
+        let e = f.entity(id).unwrap().unwrap();
+        e.get(i)
+            .text()
+            .map(|(t, _)| t.into_owned())
+            .unwrap_or_default()
+    };
+    let mut failed = 0;
+    for element in report["elements"].as_array().unwrap() {
+        let gid = element["id"].as_str().unwrap();
+        let product = f
+            .records()
+            .iter()
+            .find(|r| text(r.id, 0) == gid && f.type_name(r.type_id) != "IFCRELDEFINESBYPROPERTIES")
+            .unwrap()
+            .id;
+        let rel = f
+            .of_type("IFCRELDEFINESBYPROPERTIES")
+            .find(|r| {
+                let e = f.decode(r).unwrap();
+                e.get(4).as_list().unwrap()[0].as_ref_id() == Some(product)
+            })
+            .unwrap();
+        let pset = f.decode(rel).unwrap().get(5).as_ref_id().unwrap();
+        let props: std::collections::BTreeMap<String, String> = f
+            .entity(pset)
+            .unwrap()
+            .unwrap()
+            .get(4)
+            .as_list()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                let id = p.as_ref_id().unwrap();
+                let e = f.entity(id).unwrap().unwrap();
+                (
+                    text(id, 0),
+                    e.get(2)
+                        .text()
+                        .map(|(t, _)| t.into_owned())
+                        .unwrap_or_default(),
+                )
+            })
+            .collect();
+        assert_eq!(
+            props["FramingVerdict"], element["framing"]["status"],
+            "{gid}"
+        );
+        assert_eq!(
+            props["NailingVerdict"], element["nailing"]["status"],
+            "{gid}"
+        );
+        if element["framing"]["status"] == "failed" {
+            failed += 1;
+            let first = &element["framing"]["reasons"][0];
+            let line = format!(
+                "{}: {}",
+                first["component"].as_str().unwrap(),
+                first["message"].as_str().unwrap()
+            );
+            assert_eq!(props["Reason"], line, "{gid}");
+        }
+    }
+    assert!(failed > 0, "TM1 on the study cell fails its bottom plate");
+}
