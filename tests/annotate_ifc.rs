@@ -305,9 +305,14 @@ fn ifcopenshell_validates_and_finds_the_plan() {
         .map(|n| root().join("examples/models").join(n))
         .collect();
     models.push(root().join("tests/fixtures/synth_tm3_ifc4x3.ifc"));
-    models.extend(common::shared_path(
+    for name in [
         "ifc-realworld/timber_constructivity_wall-elemented-case_IFC4X3_ADD2.ifc",
-    ));
+        // Feet, 3048 nails; and a model with walls but no framing (nothing to schedule).
+        "ifc-realworld/timber_autotimber-xbim-generated_outer-walls-5-framed_IFC4_feet.ifc",
+        "ifc-realworld/timber_autotimber-input_revit2016_outer-walls-5-unframed_IFC4_feet.ifc",
+    ] {
+        models.extend(common::shared_path(name));
+    }
     for model in models {
         let out = dir.path().join("out.ifc");
         annotate(&model, &out, &[]);

@@ -265,8 +265,9 @@ pub fn annotate(
     let pieces: BTreeMap<&str, &Piece> =
         model.pieces().iter().map(|p| (p.id.as_str(), p)).collect();
 
-    // The work schedule, declared in the project.
-    let schedule = w.add(
+    // The work schedule, declared in the project (none when there is nothing to schedule).
+    let schedule = (!plan.walls.is_empty()).then(|| {
+        let schedule = w.add(
         "IFCWORKSCHEDULE",
         format!(
             "{},$,{},{},$,{},{},$,{},$,$,{},$,.PLANNED.",
@@ -279,13 +280,15 @@ pub fn annotate(
             string(&date),
         ),
     );
-    w.add(
-        "IFCRELDECLARES",
-        format!(
-            "{},$,$,$,#{project},({schedule})",
-            guid_for("declares", &project_gid)
-        ),
-    );
+        w.add(
+            "IFCRELDECLARES",
+            format!(
+                "{},$,$,$,#{project},({schedule})",
+                guid_for("declares", &project_gid)
+            ),
+        );
+        schedule
+    });
 
     // Per wall: a summary task, one task per piece, sequences and assignments.
     let mut wall_tasks = Vec::new();
@@ -362,7 +365,7 @@ pub fn annotate(
             sequences += 1;
         }
     }
-    if !wall_tasks.is_empty() {
+    if let (Some(schedule), false) = (schedule, wall_tasks.is_empty()) {
         w.add(
             "IFCRELASSIGNSTOCONTROL",
             format!(
@@ -554,6 +557,15 @@ fn write_nails(
     nail: NailSize,
     unit: f64,
 ) -> usize {
+    let any_nail = plan.walls.iter().any(|w| {
+        w.nailing_targets.iter().any(|t| {
+            pieces.contains_key(t.plate.as_str()) && pieces.contains_key(t.member.as_str())
+        })
+    });
+    if !any_nail {
+        // A body shared by no fastener would break IfcProductDefinitionShape's inverse rule.
+        return 0;
+    }
     let shape = body_context(file).map(|context| {
         let profile = w.add(
             "IFCCIRCLEPROFILEDEF",
