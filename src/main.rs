@@ -41,6 +41,8 @@ enum Command {
     Why(cli::why::WhyArgs),
     /// Say which rule could derive a tuple and which condition failed.
     WhyNot(cli::why::WhyNotArgs),
+    /// Write the plan (and with --simulate the verdicts) back into a copy of the IFC model.
+    Annotate(cli::annotate::AnnotateArgs),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +58,7 @@ fn main() -> ExitCode {
         Command::Check(args) => cli::check::run(args),
         Command::Why(args) => cli::why::run_why(args),
         Command::WhyNot(args) => cli::why::run_why_not(args),
+        Command::Annotate(args) => cli::annotate::run(args),
     };
     match result {
         Ok(code) => code,

@@ -44,6 +44,8 @@ pub struct SimulateArgs {
     /// to the wall's bottom edge, or `auto` (each wall where the arm reaches most of it).
     #[arg(long, value_name = "M|auto")]
     pub offset_x: Option<String>,
+    #[command(flatten)]
+    pub bcf: super::bcf::BcfArgs,
 }
 
 pub fn run(args: SimulateArgs) -> CmdResult {
@@ -71,6 +73,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         bars.update(wall, done, total)
     })?;
     bars.finish();
+    args.bcf.write(&model, &sim)?;
     let mut report = SimReport::new(&sim, options.dt);
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);

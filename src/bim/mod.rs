@@ -1,0 +1,21 @@
+//! Back into BIM tools: what framewright inferred, written where authoring and
+//! coordination tools read it.
+//!
+//! - `annotate`: the input IFC with property sets, the assembly sequence as
+//!   processes (IfcWorkSchedule, IfcTask, IfcRelSequence) and the nails as
+//!   IfcMechanicalFastener appended; the input's entities are kept byte for byte.
+//! - `bcf`: BCF 2.1 / 3.0 topics (one per root cause per wall) from a simulation.
+//! - `step_edit`: the byte-level edit of a STEP file (header record, appended entities).
+
+pub mod annotate;
+pub mod bcf;
+mod error;
+pub mod step_edit;
+mod verdicts;
+
+pub use annotate::{
+    AnnotateOptions, Annotated, ElementVerdict, NailSize, PSET_NAME, annotate, iso_date_time,
+};
+pub use bcf::{BcfHeader, BcfVersion};
+pub use error::AnnotateError;
+pub use verdicts::element_verdicts;
