@@ -41,6 +41,9 @@ enum Command {
     Why(cli::why::WhyArgs),
     /// Say which rule could derive a tuple and which condition failed.
     WhyNot(cli::why::WhyNotArgs),
+    /// Show or clear the per-wall result cache.
+    #[command(subcommand)]
+    Cache(cli::cache::CacheCommand),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Command::Check(args) => cli::check::run(args),
         Command::Why(args) => cli::why::run_why(args),
         Command::WhyNot(args) => cli::why::run_why_not(args),
+        Command::Cache(cmd) => cli::cache::run(cmd),
     };
     match result {
         Ok(code) => code,

@@ -1,6 +1,7 @@
 //! Subcommands. Every `run` returns `CmdResult`; a `Failure` carries the
 //! message shown to the user and the exit code (2 = bad input).
 
+pub mod cache;
 pub mod check;
 pub mod inspect;
 pub mod plan;

@@ -1,7 +1,9 @@
 //! `framewright simulate MODEL.ifc [--cell C] [--json] [--wall W]…`: runs the framing and
 //! nailing of every wall in the physics simulation and prints the verdicts.
 
+use super::cache::{CacheArgs, warn_if_unwritable};
 use super::{CmdResult, print_stdout, write_stdout};
+use framewright::cache::{Shard, simulate_cached, simulate_shard};
 use framewright::cell::Cell;
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
@@ -40,6 +42,12 @@ pub struct SimulateArgs {
     /// Fraction of the robot's joint speed and acceleration limits to move at (0..1].
     #[arg(long, default_value_t = 1.0)]
     pub speed: f64,
+    #[command(flatten)]
+    pub cache: CacheArgs,
+    /// Simulate only the walls whose key falls in shard K of N and store them in the cache
+    /// (for array jobs; a plain run afterwards assembles the result from the cache).
+    #[arg(long, value_name = "K/N", conflicts_with = "no_cache")]
+    pub shard: Option<Shard>,
 }
 
 pub fn run(args: SimulateArgs) -> CmdResult {
@@ -63,11 +71,33 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         |n| n.to_string_lossy().into_owned(),
     );
     let bars = Bars::new();
-    let sim = simulate_with_progress(&model, &name, &cell, &options, &|wall, done, total| {
-        bars.update(wall, done, total)
-    })?;
+    let progress = |wall: &str, done, total| bars.update(wall, done, total);
+    let cache = args.cache.open();
+    if let Some(shard) = args.shard {
+        let Some(cache) = &cache else {
+            return Err(super::Failure::bad_input(
+                "--shard needs a cache folder to put its walls in: give --cache DIR",
+            ));
+        };
+        let run = simulate_shard(&model, &name, &cell, &options, cache, shard, &progress)?;
+        bars.finish();
+        warn_if_unwritable(Some(cache));
+        return super::cache::print_shard(&run, args.json);
+    }
+    let (sim, counts) = match &cache {
+        Some(cache) => {
+            let (sim, counts) = simulate_cached(&model, &name, &cell, &options, cache, &progress)?;
+            (sim, Some(counts))
+        }
+        None => (
+            simulate_with_progress(&model, &name, &cell, &options, &progress)?,
+            None,
+        ),
+    };
     bars.finish();
+    warn_if_unwritable(cache.as_ref());
     let mut report = SimReport::new(&sim, options.dt);
+    report.sim.cache = counts;
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
     }
