@@ -7,6 +7,7 @@
 
 pub mod cache;
 pub mod cell;
+pub mod diff;
 pub mod frame;
 pub mod geom;
 pub mod ifc;

@@ -44,6 +44,10 @@ enum Command {
     /// Show or clear the per-wall result cache.
     #[command(subcommand)]
     Cache(cli::cache::CacheCommand),
+    /// What an edit changed: walls, elements, roles, assembly order, verdicts.
+    Diff(cli::diff::DiffArgs),
+    /// Simulate a model again on every save, redoing only the walls that changed.
+    Watch(cli::watch::WatchArgs),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +64,8 @@ fn main() -> ExitCode {
         Command::Why(args) => cli::why::run_why(args),
         Command::WhyNot(args) => cli::why::run_why_not(args),
         Command::Cache(cmd) => cli::cache::run(cmd),
+        Command::Diff(args) => cli::diff::run(args),
+        Command::Watch(args) => cli::watch::run(args),
     };
     match result {
         Ok(code) => code,

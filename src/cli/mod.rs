@@ -3,12 +3,14 @@
 
 pub mod cache;
 pub mod check;
+pub mod diff;
 pub mod inspect;
 pub mod plan;
 pub mod robot;
 pub mod rules;
 pub mod simulate;
 pub mod synth;
+pub mod watch;
 pub mod why;
 pub mod world;
 
