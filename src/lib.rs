@@ -6,7 +6,9 @@
 //! See `docs/ARCHITECTURE.md` for the codemap.
 
 pub mod bim;
+pub mod cache;
 pub mod cell;
+pub mod diff;
 pub mod frame;
 pub mod geom;
 pub mod ifc;

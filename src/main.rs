@@ -43,6 +43,13 @@ enum Command {
     WhyNot(cli::why::WhyNotArgs),
     /// Write the plan (and with --simulate the verdicts) back into a copy of the IFC model.
     Annotate(cli::annotate::AnnotateArgs),
+    /// Show or clear the per-wall result cache.
+    #[command(subcommand)]
+    Cache(cli::cache::CacheCommand),
+    /// What an edit changed: walls, elements, roles, assembly order, verdicts.
+    Diff(cli::diff::DiffArgs),
+    /// Simulate a model again on every save, redoing only the walls that changed.
+    Watch(cli::watch::WatchArgs),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +66,9 @@ fn main() -> ExitCode {
         Command::Why(args) => cli::why::run_why(args),
         Command::WhyNot(args) => cli::why::run_why_not(args),
         Command::Annotate(args) => cli::annotate::run(args),
+        Command::Cache(cmd) => cli::cache::run(cmd),
+        Command::Diff(args) => cli::diff::run(args),
+        Command::Watch(args) => cli::watch::run(args),
     };
     match result {
         Ok(code) => code,

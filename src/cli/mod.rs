@@ -3,13 +3,16 @@
 
 pub mod annotate;
 pub mod bcf;
+pub mod cache;
 pub mod check;
+pub mod diff;
 pub mod inspect;
 pub mod plan;
 pub mod robot;
 pub mod rules;
 pub mod simulate;
 pub mod synth;
+pub mod watch;
 pub mod why;
 pub mod world;
 

@@ -1,8 +1,10 @@
 //! `framewright simulate MODEL.ifc [--cell C] [--json] [--wall W]…`: runs the framing and
 //! nailing of every wall in the physics simulation and prints the verdicts.
 
+use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::load_cell;
 use super::{CmdResult, print_stdout, write_stdout};
+use framewright::cache::{Shard, simulate_cached, simulate_shard};
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::report::simulate::SimReport;
@@ -46,6 +48,12 @@ pub struct SimulateArgs {
     pub offset_x: Option<String>,
     #[command(flatten)]
     pub bcf: super::bcf::BcfArgs,
+    #[command(flatten)]
+    pub cache: CacheArgs,
+    /// Simulate only the walls whose key falls in shard K of N and store them in the cache
+    /// (for array jobs; a plain run afterwards assembles the result from the cache).
+    #[arg(long, value_name = "K/N", conflicts_with = "no_cache")]
+    pub shard: Option<Shard>,
 }
 
 pub fn run(args: SimulateArgs) -> CmdResult {
@@ -69,12 +77,34 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         |n| n.to_string_lossy().into_owned(),
     );
     let bars = Bars::new();
-    let sim = simulate_with_progress(&model, &name, &cell, &options, &|wall, done, total| {
-        bars.update(wall, done, total)
-    })?;
+    let progress = |wall: &str, done, total| bars.update(wall, done, total);
+    let cache = args.cache.open();
+    if let Some(shard) = args.shard {
+        let Some(cache) = &cache else {
+            return Err(super::Failure::bad_input(
+                "--shard needs a cache folder to put its walls in: give --cache DIR",
+            ));
+        };
+        let run = simulate_shard(&model, &name, &cell, &options, cache, shard, &progress)?;
+        bars.finish();
+        warn_if_unwritable(Some(cache));
+        return super::cache::print_shard(&run, args.json);
+    }
+    let (sim, counts) = match &cache {
+        Some(cache) => {
+            let (sim, counts) = simulate_cached(&model, &name, &cell, &options, cache, &progress)?;
+            (sim, Some(counts))
+        }
+        None => (
+            simulate_with_progress(&model, &name, &cell, &options, &progress)?,
+            None,
+        ),
+    };
     bars.finish();
     args.bcf.write(&model, &sim)?;
+    warn_if_unwritable(cache.as_ref());
     let mut report = SimReport::new(&sim, options.dt);
+    report.sim.cache = counts;
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
     }

@@ -125,6 +125,9 @@ pub struct SimFigures {
     pub simulated_s: f64,
     pub steps: u64,
     pub dt: f64,
+    /// Walls simulated and walls read from the cache (absent without a cache).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cache: Option<crate::cache::CacheCounts>,
 }
 
 fn sym(v: &Value) -> String {
@@ -300,6 +303,7 @@ impl SimReport {
                 simulated_s: r6(sim.records.iter().map(|r| r.nailing_end).sum()),
                 steps: sim.records.iter().map(|r| r.steps).sum(),
                 dt: r6(dt),
+                cache: None,
             },
         }
     }

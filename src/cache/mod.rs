@@ -1,0 +1,17 @@
+//! The per-wall result cache: each wall's simulation record, keyed by a content hash of
+//! exactly what that wall's simulation reads (see `key`), in a folder the user can see,
+//! share between processes and machines, and clear.
+
+pub mod key;
+pub mod record_codec;
+pub mod sim;
+pub mod store;
+
+pub use sim::{CacheCounts, Shard, ShardRun, cached_simulation, simulate_cached, simulate_shard};
+pub use store::{Cache, CacheInfo, clear, info};
+
+/// The default cache folder: `$FRAMEWRIGHT_CACHE`, else `$XDG_CACHE_HOME/framewright`, else
+/// `$HOME/.cache/framewright` (None when none is set).
+pub fn default_dir() -> Option<std::path::PathBuf> {
+    crate::user_rules::sim_cache::default_cache_dir()
+}

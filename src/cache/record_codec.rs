@@ -1,0 +1,512 @@
+//! A wall's executor record as a cache entry and back. The record type only serialises, so the
+//! entry is a mirror of it: floats as their IEEE bits (exact, NaN and infinities included) and
+//! the executor's fixed names (`pick`, `place`, belts, events) as strings. Reading an entry
+//! rebuilds the record and checks that it serialises to the bytes the original did, so a mirror
+//! that falls behind the record type is a cache miss, never a wrong answer.
+
+use crate::cell::IkFailure;
+use crate::sim::WallRecord;
+use crate::sim::record::{
+    BeltEvent, ContactRecord, IkRecord, NailOutcome, NailRecord, Operation, Placement,
+};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeSet;
+use std::sync::{Mutex, OnceLock};
+
+/// The entry file: what it answers (key), the digest of the record's own serialisation, and
+/// the record.
+#[derive(Serialize, Deserialize)]
+pub struct Entry {
+    pub format: u32,
+    pub key: String,
+    pub record_digest: String,
+    record: Rec,
+}
+
+/// The entry format; entries of another format are misses.
+pub const FORMAT: u32 = 1;
+
+impl Entry {
+    pub fn new(key: &str, record: &WallRecord) -> Entry {
+        Entry {
+            format: FORMAT,
+            key: key.to_string(),
+            record_digest: record_digest(record),
+            record: Rec::from(record),
+        }
+    }
+
+    /// The record, when the entry is of this format, answers `key` and rebuilds exactly.
+    pub fn into_record(self, key: &str) -> Option<WallRecord> {
+        if self.format != FORMAT || self.key != key {
+            return None;
+        }
+        let record = self.record.into_record()?;
+        (record_digest(&record) == self.record_digest).then_some(record)
+    }
+}
+
+/// blake3 of the record's JSON: what the report and the rules see of it.
+fn record_digest(record: &WallRecord) -> String {
+    let mut hasher = blake3::Hasher::new();
+    // Serialising plain data into a hasher cannot fail.
+    let _ = serde_json::to_writer(HashSink(&mut hasher), record);
+    hasher.finalize().to_hex().to_string()
+}
+
+struct HashSink<'a>(&'a mut blake3::Hasher);
+
+impl std::io::Write for HashSink<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.update(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// The executor names its operations, belts and events with `&'static str`; rebuilt records
+/// borrow each distinct name from this set, which holds a handful of words. An entry with
+/// more distinct names than any executor uses is not a record.
+fn intern(name: String) -> Option<&'static str> {
+    const MOST_NAMES: usize = 256;
+    static NAMES: OnceLock<Mutex<BTreeSet<&'static str>>> = OnceLock::new();
+    let mut names = NAMES.get_or_init(Default::default).lock().ok()?;
+    if let Some(known) = names.get(name.as_str()) {
+        return Some(known);
+    }
+    if names.len() >= MOST_NAMES {
+        return None;
+    }
+    let leaked: &'static str = Box::leak(name.into_boxed_str());
+    names.insert(leaked);
+    Some(leaked)
+}
+
+fn bits(x: f64) -> u64 {
+    x.to_bits()
+}
+
+fn float(b: u64) -> f64 {
+    f64::from_bits(b)
+}
+
+#[derive(Serialize, Deserialize)]
+struct Rec {
+    wall: String,
+    operations: Vec<(String, String, u64, u64)>,
+    ik: Vec<(String, String, Result<u64, IkFailureBits>)>,
+    contacts: Vec<(String, String, u64, String, String, u64)>,
+    placements: Vec<(String, u64, u64)>,
+    fed: Vec<(String, u64)>,
+    not_fed: Vec<(String, String)>,
+    grip_failed: Vec<(String, String)>,
+    nails: Vec<NailBits>,
+    belt_events: Vec<(u64, String, String, String)>,
+    framing_end: u64,
+    nailing_end: u64,
+    steps: u64,
+}
+
+#[derive(Serialize, Deserialize)]
+enum IkFailureBits {
+    OutOfReach(u64, u64, u64),
+    JointLimit(String, u64, u64, u64),
+    WristSingularity(u64, u64),
+    AllSolutionsCollide([String; 2]),
+    NoExactSolution(u64, u64),
+    InvalidPose,
+}
+
+#[derive(Serialize, Deserialize)]
+struct NailBits {
+    plate: String,
+    member: String,
+    k: i64,
+    planned: [u64; 3],
+    outcome: OutcomeBits,
+}
+
+#[derive(Serialize, Deserialize)]
+enum OutcomeBits {
+    Fired {
+        t: u64,
+        as_built: [u64; 3],
+        position_error: u64,
+        member_inside: bool,
+    },
+    Skipped {
+        kind: String,
+        what: String,
+        value: u64,
+        limit: u64,
+        message: String,
+    },
+}
+
+impl From<&IkFailure> for IkFailureBits {
+    fn from(f: &IkFailure) -> Self {
+        match f {
+            IkFailure::OutOfReach {
+                distance,
+                reach,
+                min_reach,
+            } => IkFailureBits::OutOfReach(bits(*distance), bits(*reach), bits(*min_reach)),
+            IkFailure::JointLimit {
+                joint,
+                value,
+                limit,
+                excess,
+            } => {
+                IkFailureBits::JointLimit(joint.clone(), bits(*value), bits(*limit), bits(*excess))
+            }
+            IkFailure::WristSingularity { margin, required } => {
+                IkFailureBits::WristSingularity(bits(*margin), bits(*required))
+            }
+            IkFailure::AllSolutionsCollide { pair } => {
+                IkFailureBits::AllSolutionsCollide(pair.clone())
+            }
+            IkFailure::NoExactSolution {
+                position_error,
+                rotation_error,
+            } => IkFailureBits::NoExactSolution(bits(*position_error), bits(*rotation_error)),
+            IkFailure::InvalidPose => IkFailureBits::InvalidPose,
+        }
+    }
+}
+
+impl IkFailureBits {
+    fn into_failure(self) -> IkFailure {
+        match self {
+            IkFailureBits::OutOfReach(d, r, m) => IkFailure::OutOfReach {
+                distance: float(d),
+                reach: float(r),
+                min_reach: float(m),
+            },
+            IkFailureBits::JointLimit(joint, v, l, e) => IkFailure::JointLimit {
+                joint,
+                value: float(v),
+                limit: float(l),
+                excess: float(e),
+            },
+            IkFailureBits::WristSingularity(m, r) => IkFailure::WristSingularity {
+                margin: float(m),
+                required: float(r),
+            },
+            IkFailureBits::AllSolutionsCollide(pair) => IkFailure::AllSolutionsCollide { pair },
+            IkFailureBits::NoExactSolution(p, r) => IkFailure::NoExactSolution {
+                position_error: float(p),
+                rotation_error: float(r),
+            },
+            IkFailureBits::InvalidPose => IkFailure::InvalidPose,
+        }
+    }
+}
+
+impl From<&WallRecord> for Rec {
+    fn from(r: &WallRecord) -> Self {
+        Rec {
+            wall: r.wall.clone(),
+            operations: r
+                .operations
+                .iter()
+                .map(|o| {
+                    (
+                        o.piece.clone(),
+                        o.op.to_string(),
+                        bits(o.start),
+                        bits(o.end),
+                    )
+                })
+                .collect(),
+            ik: r
+                .ik
+                .iter()
+                .map(|i| {
+                    let result = match &i.result {
+                        Ok(x) => Ok(bits(*x)),
+                        Err(f) => Err(IkFailureBits::from(f)),
+                    };
+                    (i.piece.clone(), i.op.to_string(), result)
+                })
+                .collect(),
+            contacts: r
+                .contacts
+                .iter()
+                .map(|c| {
+                    (
+                        c.piece.clone(),
+                        c.op.to_string(),
+                        bits(c.t),
+                        c.body_a.clone(),
+                        c.body_b.clone(),
+                        bits(c.depth),
+                    )
+                })
+                .collect(),
+            placements: r
+                .placements
+                .iter()
+                .map(|p| (p.piece.clone(), bits(p.position_error), bits(p.angle_error)))
+                .collect(),
+            fed: r.fed.iter().map(|(p, t)| (p.clone(), bits(*t))).collect(),
+            not_fed: r.not_fed.clone(),
+            grip_failed: r.grip_failed.clone(),
+            nails: r
+                .nails
+                .iter()
+                .map(|n| NailBits {
+                    plate: n.plate.clone(),
+                    member: n.member.clone(),
+                    k: n.k,
+                    planned: n.planned.map(bits),
+                    outcome: match &n.outcome {
+                        NailOutcome::Fired {
+                            t,
+                            as_built,
+                            position_error,
+                            member_inside,
+                        } => OutcomeBits::Fired {
+                            t: bits(*t),
+                            as_built: as_built.map(bits),
+                            position_error: bits(*position_error),
+                            member_inside: *member_inside,
+                        },
+                        NailOutcome::Skipped {
+                            kind,
+                            what,
+                            value,
+                            limit,
+                            message,
+                        } => OutcomeBits::Skipped {
+                            kind: kind.clone(),
+                            what: what.clone(),
+                            value: bits(*value),
+                            limit: bits(*limit),
+                            message: message.clone(),
+                        },
+                    },
+                })
+                .collect(),
+            belt_events: r
+                .belt_events
+                .iter()
+                .map(|b| {
+                    (
+                        bits(b.t),
+                        b.belt.to_string(),
+                        b.event.to_string(),
+                        b.piece.clone(),
+                    )
+                })
+                .collect(),
+            framing_end: bits(r.framing_end),
+            nailing_end: bits(r.nailing_end),
+            steps: r.steps,
+        }
+    }
+}
+
+impl Rec {
+    fn into_record(self) -> Option<WallRecord> {
+        let mut operations = Vec::with_capacity(self.operations.len());
+        for (piece, op, start, end) in self.operations {
+            operations.push(Operation {
+                piece,
+                op: intern(op)?,
+                start: float(start),
+                end: float(end),
+            });
+        }
+        let mut ik = Vec::with_capacity(self.ik.len());
+        for (piece, op, result) in self.ik {
+            ik.push(IkRecord {
+                piece,
+                op: intern(op)?,
+                result: result.map(float).map_err(IkFailureBits::into_failure),
+            });
+        }
+        let mut contacts = Vec::with_capacity(self.contacts.len());
+        for (piece, op, t, body_a, body_b, depth) in self.contacts {
+            contacts.push(ContactRecord {
+                piece,
+                op: intern(op)?,
+                t: float(t),
+                body_a,
+                body_b,
+                depth: float(depth),
+            });
+        }
+        let mut belt_events = Vec::with_capacity(self.belt_events.len());
+        for (t, belt, event, piece) in self.belt_events {
+            belt_events.push(BeltEvent {
+                t: float(t),
+                belt: intern(belt)?,
+                event: intern(event)?,
+                piece,
+            });
+        }
+        Some(WallRecord {
+            wall: self.wall,
+            operations,
+            ik,
+            contacts,
+            placements: self
+                .placements
+                .into_iter()
+                .map(|(piece, p, a)| Placement {
+                    piece,
+                    position_error: float(p),
+                    angle_error: float(a),
+                })
+                .collect(),
+            fed: self.fed.into_iter().map(|(p, t)| (p, float(t))).collect(),
+            not_fed: self.not_fed,
+            grip_failed: self.grip_failed,
+            nails: self
+                .nails
+                .into_iter()
+                .map(|n| NailRecord {
+                    plate: n.plate,
+                    member: n.member,
+                    k: n.k,
+                    planned: n.planned.map(float),
+                    outcome: match n.outcome {
+                        OutcomeBits::Fired {
+                            t,
+                            as_built,
+                            position_error,
+                            member_inside,
+                        } => NailOutcome::Fired {
+                            t: float(t),
+                            as_built: as_built.map(float),
+                            position_error: float(position_error),
+                            member_inside,
+                        },
+                        OutcomeBits::Skipped {
+                            kind,
+                            what,
+                            value,
+                            limit,
+                            message,
+                        } => NailOutcome::Skipped {
+                            kind,
+                            what,
+                            value: float(value),
+                            limit: float(limit),
+                            message,
+                        },
+                    },
+                })
+                .collect(),
+            belt_events,
+            framing_end: float(self.framing_end),
+            nailing_end: float(self.nailing_end),
+            steps: self.steps,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> WallRecord {
+        WallRecord {
+            wall: "2Ab$x".into(),
+            operations: vec![Operation {
+                piece: "p1".into(),
+                op: "pick",
+                start: 0.1 + 0.2,
+                end: f64::INFINITY,
+            }],
+            ik: vec![
+                IkRecord {
+                    piece: "p1".into(),
+                    op: "place",
+                    result: Ok(1e-300),
+                },
+                IkRecord {
+                    piece: "p2".into(),
+                    op: "pick",
+                    result: Err(IkFailure::JointLimit {
+                        joint: "joint_3".into(),
+                        value: 1.428,
+                        limit: 1.3,
+                        excess: f64::NAN,
+                    }),
+                },
+            ],
+            contacts: vec![],
+            placements: vec![Placement {
+                piece: "p1".into(),
+                position_error: -0.0,
+                angle_error: 3.0e-7,
+            }],
+            fed: vec![("p1".into(), 2.5)],
+            not_fed: vec![("p3".into(), "too long".into())],
+            grip_failed: vec![],
+            nails: vec![NailRecord {
+                plate: "bp".into(),
+                member: "s1".into(),
+                k: 2,
+                planned: [0.1, 0.2, 0.3],
+                outcome: NailOutcome::Skipped {
+                    kind: "ik".into(),
+                    what: "joint_5".into(),
+                    value: 0.01,
+                    limit: 0.02,
+                    message: "wrist".into(),
+                },
+            }],
+            belt_events: vec![BeltEvent {
+                t: 1.0,
+                belt: "conveyor 1",
+                event: "stop",
+                piece: "p1".into(),
+            }],
+            framing_end: 12.75,
+            nailing_end: 30.125,
+            steps: 7200,
+        }
+    }
+
+    #[test]
+    fn a_record_comes_back_bit_for_bit() {
+        let r = sample();
+        let text = serde_json::to_string(&Entry::new("k", &r)).unwrap();
+        let back: Entry = serde_json::from_str(&text).unwrap();
+        let back = back.into_record("k").unwrap();
+        assert_eq!(
+            serde_json::to_string(&back).unwrap(),
+            serde_json::to_string(&r).unwrap()
+        );
+        // NaN serialises as null, so compare the bits where JSON cannot.
+        let Err(IkFailure::JointLimit { excess, .. }) = &back.ik[1].result else {
+            panic!("the failure changed kind");
+        };
+        assert!(excess.is_nan());
+        assert_eq!(
+            back.placements[0].position_error.to_bits(),
+            (-0.0f64).to_bits()
+        );
+        assert_eq!(back.operations[0].end, f64::INFINITY);
+    }
+
+    #[test]
+    fn another_key_or_a_changed_record_is_a_miss() {
+        let r = sample();
+        let entry = |key: &str| {
+            let text = serde_json::to_string(&Entry::new(key, &r)).unwrap();
+            serde_json::from_str::<Entry>(&text).unwrap()
+        };
+        assert!(entry("k").into_record("other").is_none());
+        let mut e = entry("k");
+        e.record.steps += 1;
+        assert!(e.into_record("k").is_none());
+        let mut e = entry("k");
+        e.format += 1;
+        assert!(e.into_record("k").is_none());
+    }
+}

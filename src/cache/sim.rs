@@ -1,0 +1,366 @@
+//! `simulate` through the cache: the model is reasoned as always (walls, targets, scene),
+//! each selected wall's record is looked up by its key, only the misses are simulated, and
+//! the verdicts are reasoned over all records. The result is the one an uncached run gives.
+
+use super::key::{build_id, wall_key};
+use super::store::{Cache, Lookup};
+use crate::cell::Cell;
+use crate::frame::plan::Plan;
+use crate::frame::{Facts, Reasoned, cell_facts, model_facts, reason};
+use crate::geom::ContactOptions;
+use crate::ifc::Model;
+use crate::sim::{SimError, SimOptions, Simulation, WallRecord, simulate_with_progress};
+use crate::world::Scene;
+use serde::Serialize;
+
+/// How many walls were simulated and how many came from the cache.
+#[derive(Debug, Clone, Copy, Default, Serialize, PartialEq, Eq)]
+pub struct CacheCounts {
+    pub computed: usize,
+    pub cached: usize,
+    /// Entries found torn, corrupt or stale, and simulated again (included in `computed`).
+    pub rejected: usize,
+}
+
+/// Shard `index` of `count` (1-based, as `--shard 2/3` writes it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u64,
+    pub count: u64,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Shard, String> {
+        let bad = || format!("`{s}` is not a shard: write K/N with 1 <= K <= N, e.g. 2/3");
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let index: u64 = k.trim().parse().map_err(|_| bad())?;
+        let count: u64 = n.trim().parse().map_err(|_| bad())?;
+        if index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl Shard {
+    /// Whether a wall with this key belongs to the shard: its key's first 8 bytes, modulo the
+    /// shard count. Keys are content hashes, so shards get about equal numbers of walls.
+    pub fn holds(&self, key: &str) -> bool {
+        let head = u64::from_str_radix(&key[..16.min(key.len())], 16).unwrap_or(0);
+        head % self.count == self.index - 1
+    }
+}
+
+/// What a shard run did.
+#[derive(Debug, Serialize)]
+pub struct ShardRun {
+    pub shard: String,
+    /// Wall ids (as the plan names them) of this shard, in plan order.
+    pub walls: Vec<String>,
+    /// Walls of the other shards.
+    pub other_walls: usize,
+    pub cache: CacheCounts,
+}
+
+/// The model reasoned and its scene built: what every simulation starts from.
+struct Prepared {
+    facts: Facts,
+    scene: Scene,
+    plan: Plan,
+    /// (wall key piece, cache key) of the selected walls, in plan order.
+    walls: Vec<(String, String)>,
+}
+
+fn prepare(
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+) -> Result<Prepared, SimError> {
+    check_options(options)?;
+    let mut facts = model_facts(model, &ContactOptions::default());
+    facts.extend(cell_facts(cell));
+    let planned = reason(&facts, &options.engine, false)?;
+    let scene = Scene::build(model_name, model, cell, &planned)?;
+    let plan = Plan::from_reasoned(model, &planned);
+    let build = build_id();
+    let mut walls = Vec::new();
+    for key_piece in select_walls(&plan, &options.walls)? {
+        let (Some(scene_wall), Some(plan_wall)) = (
+            scene.walls.iter().find(|w| w.id == key_piece),
+            plan.walls.iter().find(|w| w.key == key_piece),
+        ) else {
+            // The executor skips such a wall too.
+            continue;
+        };
+        let pieces: Vec<_> = scene_wall
+            .pieces
+            .iter()
+            .filter_map(|id| scene.pieces.iter().find(|p| &p.id == id))
+            .collect();
+        let key = wall_key(build, cell, options, scene_wall, &pieces, plan_wall);
+        walls.push((key_piece, key));
+    }
+    Ok(Prepared {
+        facts,
+        scene,
+        plan,
+        walls,
+    })
+}
+
+/// Simulates the model, reading and filling the cache.
+pub fn simulate_cached(
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    cache: &Cache,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<(Simulation, CacheCounts), SimError> {
+    let prepared = prepare(model, model_name, cell, options)?;
+    let (found, misses, mut counts) = look_up(cache, &prepared.walls);
+    if found.iter().all(Option::is_none) {
+        // Nothing cached: one plain run, whose result is the answer as it stands.
+        let sim = simulate_with_progress(model, model_name, cell, options, progress)?;
+        for record in &sim.records {
+            if let Some((_, key)) = prepared.walls.iter().find(|(k, _)| k == &record.wall) {
+                cache.put_wall(key, record);
+            }
+        }
+        counts.computed = sim.records.len();
+        return Ok((sim, counts));
+    }
+    let mut computed = simulate_misses(model, model_name, cell, options, cache, &misses, progress)?;
+    counts.computed = computed.len();
+    let mut records = Vec::with_capacity(found.len());
+    for (record, (key_piece, _)) in found.into_iter().zip(&prepared.walls) {
+        match record {
+            Some(r) => records.push(r),
+            None => {
+                let at = computed.iter().position(|r| &r.wall == key_piece);
+                let r = at.map(|i| computed.swap_remove(i)).ok_or_else(|| {
+                    SimError::Option(format!("wall {key_piece} was not simulated"))
+                })?;
+                records.push(r);
+            }
+        }
+    }
+    Ok((assemble(prepared, records, options)?, counts))
+}
+
+/// The simulation of the model when the cache holds every selected wall; None otherwise
+/// (nothing is simulated).
+pub fn cached_simulation(
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    cache: &Cache,
+) -> Result<Option<Simulation>, SimError> {
+    let prepared = prepare(model, model_name, cell, options)?;
+    let (found, misses, _) = look_up(cache, &prepared.walls);
+    if !misses.is_empty() {
+        return Ok(None);
+    }
+    let records = found.into_iter().flatten().collect();
+    Ok(Some(assemble(prepared, records, options)?))
+}
+
+/// The verdicts reasoned over the records (in wall order), as `simulate` reasons them.
+fn assemble(
+    prepared: Prepared,
+    records: Vec<WallRecord>,
+    options: &SimOptions,
+) -> Result<Simulation, SimError> {
+    let Prepared {
+        mut facts,
+        scene,
+        plan,
+        ..
+    } = prepared;
+    let mut sim_facts = Facts::default();
+    for r in &records {
+        sim_facts.extend(r.facts());
+    }
+    facts.extend(sim_facts.clone());
+    let reasoned: Reasoned = reason(&facts, &options.engine, false)?;
+    Ok(Simulation {
+        scene,
+        plan,
+        records,
+        facts: sim_facts,
+        reasoned,
+    })
+}
+
+/// Simulates the walls of one shard that the cache lacks, and stores them.
+pub fn simulate_shard(
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    cache: &Cache,
+    shard: Shard,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<ShardRun, SimError> {
+    let prepared = prepare(model, model_name, cell, options)?;
+    let mine: Vec<(String, String)> = prepared
+        .walls
+        .iter()
+        .filter(|(_, key)| shard.holds(key))
+        .cloned()
+        .collect();
+    let (_, misses, mut counts) = look_up(cache, &mine);
+    counts.computed =
+        simulate_misses(model, model_name, cell, options, cache, &misses, progress)?.len();
+    let wall_ids = mine
+        .iter()
+        .filter_map(|(k, _)| prepared.plan.walls.iter().find(|w| &w.key == k))
+        .map(|w| w.id.clone())
+        .collect();
+    Ok(ShardRun {
+        shard: shard.to_string(),
+        walls: wall_ids,
+        other_walls: prepared.walls.len() - mine.len(),
+        cache: counts,
+    })
+}
+
+/// The cached record of each wall (None for a miss), the misses, and the counts so far.
+fn look_up(
+    cache: &Cache,
+    walls: &[(String, String)],
+) -> (Vec<Option<WallRecord>>, Vec<(String, String)>, CacheCounts) {
+    let mut counts = CacheCounts::default();
+    let mut found = Vec::with_capacity(walls.len());
+    let mut misses = Vec::new();
+    for (key_piece, key) in walls {
+        match cache.get_wall(key) {
+            // An entry names its wall; one for another wall with equal inputs is not reused.
+            Lookup::Hit(r) if &r.wall == key_piece => {
+                counts.cached += 1;
+                found.push(Some(*r));
+                continue;
+            }
+            Lookup::Hit(_) | Lookup::Miss => {}
+            Lookup::Rejected => counts.rejected += 1,
+        }
+        found.push(None);
+        misses.push((key_piece.clone(), key.clone()));
+    }
+    (found, misses, counts)
+}
+
+/// Simulates the missing walls (in one run) and stores their records.
+fn simulate_misses(
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    cache: &Cache,
+    misses: &[(String, String)],
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<Vec<WallRecord>, SimError> {
+    if misses.is_empty() {
+        return Ok(Vec::new());
+    }
+    let only = SimOptions {
+        walls: misses.iter().map(|(k, _)| k.clone()).collect(),
+        ..options.clone()
+    };
+    let records = simulate_with_progress(model, model_name, cell, &only, progress)?.records;
+    for r in &records {
+        if let Some((_, key)) = misses.iter().find(|(k, _)| k == &r.wall) {
+            cache.put_wall(key, r);
+        }
+    }
+    Ok(records)
+}
+
+/// The option checks of `simulate`, made before anything is read from the cache.
+fn check_options(options: &SimOptions) -> Result<(), SimError> {
+    if !(options.dt > 0.0 && options.dt <= 0.05) {
+        return Err(SimError::Option(format!(
+            "the time step must be in (0, 0.05] s, not {}",
+            options.dt
+        )));
+    }
+    if !(options.speed > 0.0 && options.speed <= 1.0) {
+        return Err(SimError::Option(format!(
+            "the speed fraction must be in (0, 1], not {}",
+            options.speed
+        )));
+    }
+    Ok(())
+}
+
+/// The key pieces of the walls to run: all, or those named by id, name or key, in plan
+/// order (as `simulate` selects them).
+fn select_walls(plan: &Plan, wanted: &[String]) -> Result<Vec<String>, SimError> {
+    if plan.walls.is_empty() {
+        let reason = if plan.warnings.is_empty() {
+            String::new()
+        } else {
+            format!(": {}", plan.warnings.join("; "))
+        };
+        return Err(SimError::NoWalls { reason });
+    }
+    let mut keys = Vec::new();
+    for name in wanted {
+        let wall = plan
+            .walls
+            .iter()
+            .find(|w| &w.id == name || &w.name == name || &w.key == name)
+            .ok_or_else(|| SimError::UnknownWall {
+                name: name.clone(),
+                known: plan
+                    .walls
+                    .iter()
+                    .map(|w| format!("{} ({})", w.name, w.id))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        keys.push(wall.key.clone());
+    }
+    Ok(plan
+        .walls
+        .iter()
+        .filter(|w| wanted.is_empty() || keys.contains(&w.key))
+        .map(|w| w.key.clone())
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_split_keys() {
+        assert_eq!("2/3".parse::<Shard>(), Ok(Shard { index: 2, count: 3 }));
+        for bad in ["0/3", "4/3", "3", "a/b", "1/0", ""] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+        // Every key lies in exactly one shard.
+        for i in 0..50u32 {
+            let key = blake3::hash(&i.to_le_bytes()).to_hex().to_string();
+            let n = (1..=3)
+                .filter(|k| {
+                    Shard {
+                        index: *k,
+                        count: 3,
+                    }
+                    .holds(&key)
+                })
+                .count();
+            assert_eq!(n, 1, "{key}");
+        }
+    }
+}

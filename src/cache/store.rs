@@ -1,0 +1,202 @@
+//! The cache folder: one file per entry, written beside its final name and renamed into
+//! place, so a reader (this process or another sharing the folder) sees a whole entry or
+//! none. An entry that cannot be read, parsed or verified is a miss and is written again.
+//! A folder that cannot be written (read-only, full disk) turns writing off with one warning.
+
+use super::record_codec::Entry;
+use crate::sim::WallRecord;
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Subfolder of wall simulation entries.
+const WALLS: &str = "walls";
+/// Entries of `why`'s single-wall cache, kept at the top of the folder.
+const WHY_PREFIX: &str = "sim-";
+
+/// A cache folder in use.
+pub struct Cache {
+    dir: PathBuf,
+    write_failed: AtomicBool,
+    warning: Mutex<Option<String>>,
+}
+
+/// What looking up a wall found.
+pub enum Lookup {
+    Hit(Box<WallRecord>),
+    Miss,
+    /// An entry was there but was torn, corrupt, of another format or answered another key.
+    Rejected,
+}
+
+impl Cache {
+    pub fn new(dir: impl Into<PathBuf>) -> Cache {
+        Cache {
+            dir: dir.into(),
+            write_failed: AtomicBool::new(false),
+            warning: Mutex::new(None),
+        }
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    fn wall_path(&self, key: &str) -> PathBuf {
+        // Two-character fan-out keeps folders small on shared filesystems.
+        self.dir
+            .join(WALLS)
+            .join(&key[..2.min(key.len())])
+            .join(format!("{key}.json"))
+    }
+
+    pub fn get_wall(&self, key: &str) -> Lookup {
+        let Ok(bytes) = std::fs::read(self.wall_path(key)) else {
+            return Lookup::Miss;
+        };
+        match serde_json::from_slice::<Entry>(&bytes)
+            .ok()
+            .and_then(|e| e.into_record(key))
+        {
+            Some(record) => Lookup::Hit(Box::new(record)),
+            None => Lookup::Rejected,
+        }
+    }
+
+    /// Stores a wall's record; a failure turns writing off for this run and leaves a warning.
+    pub fn put_wall(&self, key: &str, record: &WallRecord) {
+        if self.write_failed.load(Ordering::Relaxed) {
+            return;
+        }
+        let path = self.wall_path(key);
+        if let Err(e) = write_atomically(&path, &Entry::new(key, record))
+            && !self.write_failed.swap(true, Ordering::Relaxed)
+            && let Ok(mut w) = self.warning.lock()
+        {
+            *w = Some(format!(
+                "cannot write to the cache folder {} ({e}); going on without storing results \
+                 (give --cache DIR for a writable folder, or --no-cache)",
+                self.dir.display()
+            ));
+        }
+    }
+
+    /// The warning of a failed write, once.
+    pub fn take_warning(&self) -> Option<String> {
+        self.warning.lock().ok().and_then(|mut w| w.take())
+    }
+}
+
+fn write_atomically(path: &Path, entry: &impl Serialize) -> std::io::Result<()> {
+    let dir = path
+        .parent()
+        .ok_or_else(|| std::io::Error::other("an entry path has no folder"))?;
+    std::fs::create_dir_all(dir)?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".entry-")
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
+    serde_json::to_writer(tmp.as_file_mut(), entry)?;
+    tmp.as_file_mut().flush()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// What a cache folder holds.
+#[derive(Debug, Default, Serialize, PartialEq)]
+pub struct CacheInfo {
+    pub dir: PathBuf,
+    /// Simulated walls (`simulate`, `plan`, `diff`, `watch`).
+    pub walls: u64,
+    /// Walls simulated for `why`.
+    pub why_walls: u64,
+    pub bytes: u64,
+}
+
+/// Counts the entries of a cache folder (an absent folder is empty).
+pub fn info(dir: &Path) -> std::io::Result<CacheInfo> {
+    let mut info = CacheInfo {
+        dir: dir.to_path_buf(),
+        ..CacheInfo::default()
+    };
+    for file in entry_files(dir)? {
+        let bytes = std::fs::metadata(&file.path).map_or(0, |m| m.len());
+        info.bytes += bytes;
+        match file.kind {
+            Kind::Wall => info.walls += 1,
+            Kind::Why => info.why_walls += 1,
+        }
+    }
+    Ok(info)
+}
+
+/// Removes every entry framewright wrote in `dir` (and nothing else); returns how many.
+pub fn clear(dir: &Path) -> std::io::Result<u64> {
+    let mut removed = 0;
+    for file in entry_files(dir)? {
+        match std::fs::remove_file(&file.path) {
+            Ok(()) => removed += 1,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(e),
+        }
+    }
+    // Now-empty fan-out folders go too; a folder something else put files in stays.
+    if let Ok(subdirs) = std::fs::read_dir(dir.join(WALLS)) {
+        for sub in subdirs.flatten() {
+            let _ = std::fs::remove_dir(sub.path());
+        }
+        let _ = std::fs::remove_dir(dir.join(WALLS));
+    }
+    Ok(removed)
+}
+
+enum Kind {
+    Wall,
+    Why,
+}
+
+struct EntryFile {
+    path: PathBuf,
+    kind: Kind,
+}
+
+/// The entry files (and left-over temporary files) of a cache folder, sorted.
+fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
+    let mut files = Vec::new();
+    let top = match std::fs::read_dir(dir) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(files),
+        Err(e) => return Err(e),
+    };
+    for e in top.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with(WHY_PREFIX) && (name.ends_with(".json") || name.contains(".tmp")) {
+            files.push(EntryFile {
+                path: e.path(),
+                kind: Kind::Why,
+            });
+        }
+    }
+    if let Ok(subdirs) = std::fs::read_dir(dir.join(WALLS)) {
+        for sub in subdirs.flatten() {
+            let Ok(entries) = std::fs::read_dir(sub.path()) else {
+                continue;
+            };
+            for e in entries.flatten() {
+                let name = e.file_name().to_string_lossy().into_owned();
+                if name.ends_with(".json")
+                    || (name.starts_with(".entry-") && name.ends_with(".tmp"))
+                {
+                    files.push(EntryFile {
+                        path: e.path(),
+                        kind: Kind::Wall,
+                    });
+                }
+            }
+        }
+    }
+    files.sort_by(|a, b| a.path.cmp(&b.path));
+    Ok(files)
+}
