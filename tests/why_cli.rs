@@ -99,6 +99,8 @@ fn why_text_names_the_element_rules_and_sources() {
     let m = tm3();
     let text = ok(&[
         "why",
+        "--offset-x",
+        "0.531",
         m.to_str().unwrap(),
         "32H5oapRpM57uELNCcVku8",
         "--no-simulate",
@@ -129,6 +131,8 @@ fn why_explains_user_findings() {
     let rules = root().join("examples/rules/gripper_spacing.dl");
     let text = ok(&[
         "why",
+        "--offset-x",
+        "0.531",
         model.to_str().unwrap(),
         "#213",
         "--rules",
@@ -255,6 +259,8 @@ fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
     let m = tm3();
     let args = [
         "why",
+        "--offset-x",
+        "0.531",
         m.to_str().unwrap(),
         "#174",
         "--cache-dir",

@@ -136,9 +136,16 @@ fn cache_key(
 
 /// The executor's source, part of the cache key (the package version does not change between
 /// builds of a working copy).
-const SIM_SOURCES: [&str; 6] = [
+const SIM_SOURCES: [&str; 13] = [
     include_str!("../sim/mod.rs"),
     include_str!("../sim/executor/mod.rs"),
+    include_str!("../sim/executor/feeding.rs"),
+    include_str!("../sim/executor/framing.rs"),
+    include_str!("../sim/executor/nailing.rs"),
+    include_str!("../sim/executor/paths.rs"),
+    include_str!("../sim/executor/as_built.rs"),
+    include_str!("../frame/placement.rs"),
+    include_str!("../cell/tcp_poses.rs"),
     include_str!("../sim/physics.rs"),
     include_str!("../sim/motion.rs"),
     include_str!("../sim/reach.rs"),
