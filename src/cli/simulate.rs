@@ -24,6 +24,10 @@ pub struct SimulateArgs {
     /// Print JSON instead of the tables.
     #[arg(long)]
     pub json: bool,
+    /// List every failed element, nail and contact, and each root cause's consequences
+    /// (without it: the table and the root causes with their counts).
+    #[arg(long, short = 'v')]
+    pub verbose: bool,
     /// Simulate only this wall (id or name); repeat for more.
     #[arg(long = "wall", value_name = "W")]
     pub walls: Vec<String>,
@@ -74,7 +78,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     if args.json {
         write_stdout(|out| report.write_json(out))
     } else {
-        print_stdout(&report.to_text())
+        print_stdout(&report.to_terminal(args.verbose))
     }
 }
 

@@ -1,6 +1,7 @@
 //! Outputs a person or a program reads. Numbers in JSON are rounded to the
 //! nanometre so that output is stable and free of float noise.
 
+pub mod causes;
 pub mod inspect;
 pub mod plan;
 pub mod simulate;
