@@ -1,10 +1,11 @@
 //! `framewright simulate MODEL.ifc [--cell C] [--json] [--wall W]…`: runs the framing and
 //! nailing of every wall in the physics simulation and prints the verdicts.
 
-use super::{CmdResult, print_stdout, write_stdout};
+use super::{CmdResult, Failure, print_stdout, write_stdout};
 use framewright::cell::Cell;
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
+use framewright::report::html::{ReportInput, write_report};
 use framewright::report::simulate::SimReport;
 use framewright::sim::{SimOptions, simulate_with_progress};
 use framewright::user_rules::UserRules;
@@ -24,6 +25,10 @@ pub struct SimulateArgs {
     /// Print JSON instead of the tables.
     #[arg(long)]
     pub json: bool,
+    /// Also write a report folder: index.html (tables, drawings, timeline), scene.glb (the
+    /// animated run; one per wall when there are several) and simulate.json.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
     /// List every failed element, nail and contact, and each root cause's consequences
     /// (without it: the table and the root causes with their counts).
     #[arg(long, short = 'v')]
@@ -74,6 +79,18 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     let mut report = SimReport::new(&sim, options.dt);
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
+    }
+    if let Some(dir) = &args.report {
+        let input = ReportInput {
+            model: &model,
+            model_name: &name,
+            cell: &cell,
+            sim: &sim,
+            report: &report,
+        };
+        write_report(dir, &input).map_err(|e| {
+            Failure::bad_input(format!("{}: cannot write the report: {e}", dir.display()))
+        })?;
     }
     if args.json {
         write_stdout(|out| report.write_json(out))
