@@ -466,3 +466,49 @@ fn writing_over_a_folder_that_is_no_report_is_refused() {
     write(&r, &out);
     assert!(out.join("index.html").exists() && out.join("scene.glb").exists());
 }
+
+#[test]
+fn world_as_gltf_is_a_valid_static_scene_with_every_piece() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("world.glb");
+    let run = Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(["world", "examples/models/tm1.ifc", "--format", "gltf", "-o"])
+        .arg(&out)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let glb = std::fs::read(&out).unwrap();
+    let (doc, _) = chunks(&glb);
+    let pieces = doc["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|n| n["name"].as_str().is_some_and(|s| s.starts_with("piece ")))
+        .count();
+    let model = Model::open(root().join("examples/models/tm1.ifc")).unwrap();
+    assert_eq!(pieces, model.pieces.len());
+    assert!(doc.get("animations").is_none());
+    if let Some(v) = validate(&out) {
+        assert_eq!(v["issues"]["numErrors"], 0, "{v:#}");
+    }
+    // A binary is not written to the terminal.
+    let refused = Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args([
+            "world",
+            "examples/models/tm1.ifc",
+            "--format",
+            "gltf",
+            "-o",
+            "-",
+        ])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("-o FILE.glb"));
+}

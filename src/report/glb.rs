@@ -24,7 +24,7 @@ const BELT_SLAB: f64 = 0.10;
 /// Largest position and angle error a dropped key may cause (m, rad).
 const KEY_TOLERANCE: (f64, f64) = (1e-4, 2e-4);
 /// Longest run of samples one pair of keys may span (bounds the reduction's work).
-const MAX_SPAN: usize = 400;
+const MAX_SPAN: usize = 32;
 
 /// The static world: cell, robot at home, every piece at its framing target (grey).
 pub fn world_glb(cell: &Cell, scene: &Scene) -> Vec<u8> {

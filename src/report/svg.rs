@@ -14,6 +14,8 @@ use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 /// Drawing width of the elevation and the plan view (px).
 const WIDTH: f64 = 880.0;
 const MARGIN: f64 = 30.0;
+/// Tallest drawing of the cell from above (px).
+const PLAN_HEIGHT: f64 = 700.0;
 
 fn f1(x: f64) -> String {
     format!("{x:.1}")
@@ -42,7 +44,7 @@ fn tooltip(p: &PieceView) -> String {
 /// A scale bar of `metres` drawn at (x, y) with `px_per_m`.
 fn scale_bar(x: f64, y: f64, px_per_m: f64) -> Markup {
     // The largest of 0.1 / 0.5 / 1 / 2 / 5 m that fits in 200 px.
-    let metres = [5.0, 2.0, 1.0, 0.5, 0.1]
+    let metres = [5.0, 2.0, 1.0, 0.5, 0.2, 0.1]
         .into_iter()
         .find(|m| m * px_per_m <= 200.0)
         .unwrap_or(0.1);
@@ -188,7 +190,8 @@ pub(super) fn plan_view(cell: &Cell, view: &WallView, thickness: f64) -> Markup 
         .map(|p| p[1])
         .fold(f64::NEG_INFINITY, f64::max)
         + pad;
-    let s = (WIDTH - 2.0 * MARGIN) / (xmax - xmin);
+    // As wide as the page allows, no taller than PLAN_HEIGHT.
+    let s = ((WIDTH - 2.0 * MARGIN) / (xmax - xmin)).min(PLAN_HEIGHT / (ymax - ymin));
     let height = (ymax - ymin) * s + 2.0 * MARGIN + 30.0;
     let x = |v: f64| MARGIN + (v - xmin) * s;
     let y = |v: f64| MARGIN + (ymax - v) * s;
