@@ -3,10 +3,11 @@
 
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::load_cell;
-use super::{CmdResult, print_stdout, write_stdout};
+use super::{CmdResult, Failure, print_stdout, write_stdout};
 use framewright::cache::{Shard, simulate_cached, simulate_shard};
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
+use framewright::report::html::{ReportInput, write_report};
 use framewright::report::simulate::SimReport;
 use framewright::sim::{SimOptions, simulate_with_progress};
 use framewright::user_rules::UserRules;
@@ -26,6 +27,14 @@ pub struct SimulateArgs {
     /// Print JSON instead of the tables.
     #[arg(long)]
     pub json: bool,
+    /// Also write a report folder: index.html (tables, drawings, timeline), scene.glb (the
+    /// animated run; one per wall when there are several) and simulate.json.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// List every failed element, nail and contact, and each root cause's consequences
+    /// (without it: the table and the root causes with their counts).
+    #[arg(long, short = 'v')]
+    pub verbose: bool,
     /// Simulate only this wall (id or name); repeat for more.
     #[arg(long = "wall", value_name = "W")]
     pub walls: Vec<String>,
@@ -108,10 +117,22 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
     }
+    if let Some(dir) = &args.report {
+        let input = ReportInput {
+            model: &model,
+            model_name: &name,
+            cell: &cell,
+            sim: &sim,
+            report: &report,
+        };
+        write_report(dir, &input).map_err(|e| {
+            Failure::bad_input(format!("{}: cannot write the report: {e}", dir.display()))
+        })?;
+    }
     if args.json {
         write_stdout(|out| report.write_json(out))
     } else {
-        print_stdout(&report.to_text())
+        print_stdout(&report.to_terminal(args.verbose))
     }
 }
 

@@ -15,6 +15,8 @@ pub enum WorldFormat {
     Json,
     /// A Webots R2023b world.
     Wbt,
+    /// A glTF 2.0 binary (.glb) of the cell, the robot at home and the lumber at its targets.
+    Gltf,
 }
 
 #[derive(clap::Args)]
@@ -34,17 +36,23 @@ pub struct WorldArgs {
 pub fn run(args: WorldArgs) -> CmdResult {
     let cell = Cell::load(&args.cell)?;
     let scene = Scene::from_model_file(&args.model, &cell)?;
-    let text = match args.format {
-        WorldFormat::Json => json::to_json(&scene),
-        WorldFormat::Wbt => wbt::to_wbt(&scene),
+    let bytes = match args.format {
+        WorldFormat::Json => json::to_json(&scene).into_bytes(),
+        WorldFormat::Wbt => wbt::to_wbt(&scene).into_bytes(),
+        WorldFormat::Gltf => framewright::report::glb::world_glb(&cell, &scene),
     };
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
     if args.output == Path::new("-") {
-        return print_stdout(&text);
+        if matches!(args.format, WorldFormat::Gltf) {
+            return Err(Failure::bad_input(
+                "a glTF binary is not written to a terminal: give -o FILE.glb".to_string(),
+            ));
+        }
+        return print_stdout(&String::from_utf8_lossy(&bytes));
     }
-    write_atomically(&args.output, text.as_bytes()).map_err(|e| {
+    write_atomically(&args.output, &bytes).map_err(|e| {
         Failure::bad_input(format!(
             "{}: cannot write the world: {e}",
             args.output.display()

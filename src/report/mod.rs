@@ -1,9 +1,16 @@
 //! Outputs a person or a program reads. Numbers in JSON are rounded to the
 //! nanometre so that output is stable and free of float noise.
 
+pub mod causes;
+pub mod glb;
+pub mod html;
 pub mod inspect;
+mod mesh;
 pub mod plan;
 pub mod simulate;
+pub mod svg;
+pub mod verdict;
+pub mod wall_view;
 
 /// Rounds a length to 1e-9 m (and turns -0 into 0).
 pub fn round_m(x: f64) -> f64 {

@@ -327,9 +327,8 @@ impl SimReport {
         writeln!(out)
     }
 
-    /// The human report: the results table, failed elements with one-line reasons, the
-    /// nailing validation per target and the contacts.
-    pub fn to_text(&self) -> String {
+    /// The results table of the study (Table 5): one row per wall.
+    pub fn table_text(&self) -> String {
         use std::fmt::Write;
         let mut s = String::new();
         let _ = writeln!(
@@ -358,6 +357,106 @@ impl SimReport {
                 dash(&w.nailing.failed_component),
             );
         }
+        s
+    }
+
+    /// The terminal report: the results table, then per wall its root causes with the number
+    /// of their consequences (listed too when `verbose`), the nailing validation in one line
+    /// and the simulated time; `verbose` adds the full per-element and per-nail detail.
+    pub fn to_terminal(&self, verbose: bool) -> String {
+        use std::fmt::Write;
+        if verbose {
+            let mut s = self.to_text();
+            let _ = write!(s, "{}", self.causes_text(true));
+            return s;
+        }
+        let mut s = self.table_text();
+        let _ = write!(s, "{}", self.causes_text(false));
+        let _ = writeln!(s, "\n{}", self.validation_line());
+        if !self.contacts.is_empty() {
+            let _ = writeln!(
+                s,
+                "{} contacts the robot should not have made (--verbose lists them)",
+                self.contacts.len()
+            );
+        }
+        let _ = writeln!(s, "{}", self.figures_line());
+        s
+    }
+
+    /// Per wall its root causes, each with the count (or the list) of its consequences.
+    fn causes_text(&self, list: bool) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        for w in &self.walls {
+            let causes = super::causes::root_causes(self, &w.wall_id);
+            if causes.is_empty() {
+                continue;
+            }
+            let _ = writeln!(s, "\nroot causes in {} ({}):", w.name, w.wall_id);
+            let role = |id: &str| {
+                self.elements
+                    .iter()
+                    .find(|e| e.id == id)
+                    .map_or("", |e| e.role.as_str())
+            };
+            for c in &causes {
+                let n = c.consequences.len();
+                let more = match n {
+                    0 => String::new(),
+                    1 => " — and 1 consequence".to_string(),
+                    _ => format!(" — and {n} consequences"),
+                };
+                let _ = writeln!(
+                    s,
+                    "  {} {} {} {}: {}{}",
+                    c.piece,
+                    role(&c.piece),
+                    c.stage,
+                    c.component,
+                    c.message,
+                    more
+                );
+                if list {
+                    for q in &c.consequences {
+                        let _ = writeln!(s, "      {}", q.message);
+                    }
+                }
+            }
+        }
+        s
+    }
+
+    fn validation_line(&self) -> String {
+        let v = &self.nailing_validation;
+        format!(
+            "nailing validation: {} of {} nails driven and checked against the as-built pieces; max error {:.2} mm ({:.2} %); {}",
+            v.checked,
+            v.planned,
+            v.max_error_mm,
+            v.max_error_pct,
+            if v.all_inside_members {
+                "every nail runs into its member"
+            } else {
+                "SOME NAILS MISS THEIR MEMBER"
+            }
+        )
+    }
+
+    fn figures_line(&self) -> String {
+        format!(
+            "simulated {:.1} s in {} steps of {:.2} ms",
+            self.sim.simulated_s,
+            self.sim.steps,
+            self.sim.dt * 1000.0
+        )
+    }
+
+    /// The full human report: the results table, failed elements with one-line reasons, the
+    /// nailing validation per target and the contacts.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write;
+        let mut s = self.table_text();
         let failed: Vec<&ElementRow> = self
             .elements
             .iter()
@@ -399,19 +498,7 @@ impl SimReport {
             }
         }
         let v = &self.nailing_validation;
-        let _ = writeln!(
-            s,
-            "\nnailing validation: {} of {} nails driven and checked against the as-built pieces; max error {:.2} mm ({:.2} %); {}",
-            v.checked,
-            v.planned,
-            v.max_error_mm,
-            v.max_error_pct,
-            if v.all_inside_members {
-                "every nail runs into its member"
-            } else {
-                "SOME NAILS MISS THEIR MEMBER"
-            }
-        );
+        let _ = writeln!(s, "\n{}", self.validation_line());
         let _ = writeln!(
             s,
             "  {:<8} {:<24} {:<24} {:>2} {:>24} {:>24} {:>8}",
@@ -441,13 +528,7 @@ impl SimReport {
                 );
             }
         }
-        let _ = writeln!(
-            s,
-            "\nsimulated {:.1} s in {} steps of {:.2} ms",
-            self.sim.simulated_s,
-            self.sim.steps,
-            self.sim.dt * 1000.0
-        );
+        let _ = writeln!(s, "\n{}", self.figures_line());
         s
     }
 }

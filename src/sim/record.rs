@@ -4,7 +4,9 @@
 use crate::cell::IkFailure;
 use crate::frame::Facts;
 use crate::logic::{Origin, Value};
+use nalgebra::Isometry3;
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// One operation on an element.
 #[derive(Debug, Clone, Serialize)]
@@ -100,6 +102,95 @@ pub struct WallRecord {
     pub nailing_end: f64,
     /// Physics steps taken.
     pub steps: u64,
+    /// The robot's and the lumber's poses over time, for animations.
+    #[serde(skip)]
+    pub trace: PoseTrace,
+}
+
+/// How often the executor samples poses for the trace (s): 20 Hz.
+pub const TRACE_PERIOD: f64 = 0.05;
+/// A lumber pose that moved less than this since its last key is at rest (m, rad).
+const REST_MOVE: f64 = 1e-5;
+
+/// Poses sampled every [`TRACE_PERIOD`] of simulated time: the robot's joint values and its
+/// tool pose as the executor computes them (cell frame), and per lumber piece the keys of its
+/// body pose (a piece at rest is kept as its first and last pose only).
+#[derive(Debug, Clone, Default)]
+pub struct PoseTrace {
+    pub times: Vec<f64>,
+    pub joints: Vec<Vec<f64>>,
+    /// tool0 in the cell frame.
+    pub tool: Vec<Isometry3<f64>>,
+    /// Piece id → its keys (time, body pose in the cell frame); the piece exists from its
+    /// first key to `gone` (or the end).
+    pub lumber: BTreeMap<String, LumberTrack>,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct LumberTrack {
+    pub keys: Vec<(f64, Isometry3<f64>)>,
+    /// When the piece left the world (taken off the belt), if it did.
+    pub gone: Option<f64>,
+    /// The last sample seen while at rest, not yet a key.
+    held: Option<(f64, Isometry3<f64>)>,
+}
+
+impl PoseTrace {
+    /// Whether a sample is due at simulated time `t`.
+    pub fn due(&self, t: f64) -> bool {
+        self.times
+            .last()
+            .is_none_or(|last| t >= last + TRACE_PERIOD - 1e-9)
+    }
+
+    /// Records one sample: joint values, tool0 and every lumber body present.
+    pub fn sample(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        tool: Isometry3<f64>,
+        lumber: BTreeMap<String, Isometry3<f64>>,
+    ) {
+        self.times.push(t);
+        self.joints.push(q.to_vec());
+        self.tool.push(tool);
+        for (id, track) in &mut self.lumber {
+            if track.gone.is_none() && !lumber.contains_key(id) {
+                track.flush();
+                track.gone = Some(t);
+            }
+        }
+        for (id, pose) in lumber {
+            let track = self.lumber.entry(id).or_default();
+            let Some(&(_, last)) = track.keys.last() else {
+                track.keys.push((t, pose));
+                continue;
+            };
+            let moved = (pose.translation.vector - last.translation.vector).norm() > REST_MOVE
+                || pose.rotation.angle_to(&last.rotation) > REST_MOVE;
+            if moved {
+                track.flush();
+                track.keys.push((t, pose));
+            } else {
+                track.held = Some((t, pose));
+            }
+        }
+    }
+
+    /// Ends the trace: the last rest pose of every piece becomes a key.
+    pub fn finish(&mut self) {
+        for track in self.lumber.values_mut() {
+            track.flush();
+        }
+    }
+}
+
+impl LumberTrack {
+    fn flush(&mut self) {
+        if let Some(key) = self.held.take() {
+            self.keys.push(key);
+        }
+    }
 }
 
 /// The `what`, value and limit columns of an IK failure.

@@ -131,6 +131,7 @@ impl<'a> WallRun<'a> {
         self.record.nailing_end = self.t;
         self.settle();
         self.measure(nails);
+        self.record.trace.finish();
         (self.progress)(total, total);
         self.record.contacts = std::mem::take(&mut self.contacts)
             .into_iter()
@@ -174,6 +175,11 @@ impl<'a> WallRun<'a> {
         self.phys.step();
         self.t += self.options.dt;
         self.record.steps += 1;
+        if self.record.trace.due(self.t) {
+            let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
+            let lumber = self.phys.lumber_poses();
+            self.record.trace.sample(self.t, &self.q, tool, lumber);
+        }
         self.feed();
         self.watch_sensor();
         self.watch_contacts();

@@ -1,0 +1,311 @@
+//! The report a person reads: `simulate --report DIR` writes `index.html` (one self-contained
+//! page: inline CSS and SVG, no script, no network, no dates), `scene.glb` (or one
+//! `scene-NNN.glb` per wall when there are several) and `simulate.json`. With more than
+//! [`WALLS_PER_PAGE`] walls the index keeps the table and the root causes and each wall gets
+//! its own page `wall-NNN.html`.
+//!
+//! Every name and id from the model goes through maud, which escapes text and attribute
+//! values by default.
+
+use super::glb;
+use super::simulate::SimReport;
+use super::svg;
+use super::verdict;
+use super::wall_view::WallView;
+use crate::cell::Cell;
+use crate::ifc::Model;
+use crate::sim::Simulation;
+use maud::{DOCTYPE, Markup, PreEscaped, html};
+use std::path::{Path, PathBuf};
+
+/// Walls drawn on the index page itself; more get a page each.
+pub const WALLS_PER_PAGE: usize = 8;
+
+const STYLE: &str = r#"
+body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 960px; }
+table { border-collapse: collapse; margin: 0.5em 0 1em; font-size: 13px; }
+th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; }
+section.wall { border-top: 2px solid #455a64; margin-top: 2em; }
+.legend span { display: inline-block; padding: 0 6px; margin-right: 6px; border: 1px solid #333; font-size: 12px; }
+.causes li { margin: 0.3em 0; }
+svg { display: block; margin: 0.5em 0; background: #fafafa; border: 1px solid #ddd; }
+svg g.piece:hover rect, svg polygon.piece:hover { stroke-width: 3; }
+rect.op { fill: #90a4ae; } rect.op.feed { fill: #cfd8dc; } rect.op.pick { fill: #42a5f5; }
+rect.op.move { fill: #7e57c2; } rect.op.place { fill: #26a69a; } rect.op.retract { fill: #b0bec5; }
+rect.op.nail { fill: #6d4c41; }
+"#;
+
+/// Everything one report needs.
+pub struct ReportInput<'a> {
+    pub model: &'a Model,
+    /// The model as named on the command line.
+    pub model_name: &'a str,
+    pub cell: &'a Cell,
+    pub sim: &'a Simulation,
+    pub report: &'a SimReport,
+}
+
+/// The files of a report, by name in the report folder, in writing order.
+pub fn report_files(input: &ReportInput) -> Vec<(String, Vec<u8>)> {
+    let walls: Vec<WallView> = input
+        .report
+        .walls
+        .iter()
+        .filter_map(|w| WallView::new(input.sim, input.report, Some(input.model), &w.wall_id))
+        .collect();
+    let split = walls.len() > WALLS_PER_PAGE;
+    let mut files = Vec::new();
+    let scene_name = |i: usize| {
+        if walls.len() == 1 {
+            "scene.glb".to_string()
+        } else {
+            format!("scene-{:03}.glb", i + 1)
+        }
+    };
+    let page_name = |i: usize| format!("wall-{:03}.html", i + 1);
+    let index = page(
+        input,
+        "Simulation report",
+        html! {
+            (header(input))
+            (results_table(&walls, split.then_some(&page_name), &scene_name))
+            @if split {
+                @for w in &walls { (causes(w)) }
+            } @else {
+                @for (i, w) in walls.iter().enumerate() { (wall_section(input, w, &scene_name(i))) }
+            }
+            (validation(input.report))
+        },
+    );
+    files.push(("index.html".to_string(), index.into_string().into_bytes()));
+    if split {
+        for (i, w) in walls.iter().enumerate() {
+            let body = html! {
+                p { a href="index.html" { "← all walls" } }
+                (header(input))
+                (wall_section(input, w, &scene_name(i)))
+            };
+            let title = format!("{} — simulation report", w.row.name);
+            files.push((
+                page_name(i),
+                page(input, &title, body).into_string().into_bytes(),
+            ));
+        }
+    }
+    for (i, w) in walls.iter().enumerate() {
+        if let Some(bytes) = glb::wall_glb(input.cell, input.sim, input.report, &w.record.wall) {
+            files.push((scene_name(i), bytes));
+        }
+    }
+    let mut json = Vec::new();
+    if input.report.write_json(&mut json).is_ok() {
+        files.push(("simulate.json".to_string(), json));
+    }
+    files
+}
+
+fn page(input: &ReportInput, title: &str, body: Markup) -> Markup {
+    html! {
+        (DOCTYPE)
+        html lang="en" {
+            head {
+                meta charset="utf-8";
+                title { (title) " — " (input.model_name) }
+                style { (PreEscaped(STYLE)) }
+            }
+            body { (body) }
+        }
+    }
+}
+
+fn header(input: &ReportInput) -> Markup {
+    let m = input.model;
+    let robot = &input.cell.robot;
+    html! {
+        h1 { "Simulation of " (input.model_name) }
+        table class="inputs" {
+            tr { th { "model" } td { (input.model_name) } }
+            tr { th { "schema" } td { (m.schema_identifier) } }
+            tr { th { "length unit" } td { (m.length_unit.name) " (" (m.length_unit.metres_per_unit) " m)" } }
+            tr { th { "cell" } td { (input.cell.name) } }
+            tr { th { "robot" } td { (robot.name) } }
+            tr { th { "tool" } td { (input.cell.tool.name) } }
+            tr { th { "simulated" } td { (format!("{:.1} s in {} steps of {:.2} ms", input.report.sim.simulated_s, input.report.sim.steps, input.report.sim.dt * 1000.0)) } }
+        }
+        p class="legend" {
+            @for c in verdict::CLASSES {
+                span style=(format!("background: {}", verdict::colour(c))) { (c.replace('-', " ")) }
+            }
+        }
+    }
+}
+
+fn results_table(
+    walls: &[WallView],
+    pages: Option<&dyn Fn(usize) -> String>,
+    scenes: &dyn Fn(usize) -> String,
+) -> Markup {
+    html! {
+        h2 { "Results" }
+        table class="results" {
+            tr {
+                th { "wall" } th { "material feeding" } th { "framing" } th { "time" } th { "failed component" }
+                th { "nailing" } th { "time" } th { "failed component" } th { "pieces placed" } th { "nails driven" }
+                th { "smallest reach margin" } th { "simulated time" } th { "3D" }
+            }
+            @for (i, w) in walls.iter().enumerate() {
+                @let r = w.row;
+                @let (placed, pieces) = w.placed();
+                @let (driven, nails) = w.driven();
+                tr data-wall=(r.wall_id) {
+                    td {
+                        @if let Some(page) = pages { a href=(page(i)) { (r.name) " (" (r.wall_id) ")" } }
+                        @else { a href=(format!("#wall-{}", i + 1)) { (r.name) " (" (r.wall_id) ")" } }
+                    }
+                    td { (r.material_feeding) }
+                    td { (r.framing.status) } td class="num" { (format!("{:.1} s", r.framing.time_s)) } td { (r.framing.failed_component) }
+                    td { (r.nailing.status) } td class="num" { (format!("{:.1} s", r.nailing.time_s)) } td { (r.nailing.failed_component) }
+                    td class="num" { (placed) "/" (pieces) }
+                    td class="num" { (driven) "/" (nails) }
+                    td class="num" { @if let Some(m) = w.min_margin { (format!("{:.0} mm", m * 1000.0)) } @else { "–" } }
+                    td class="num" { (format!("{:.1} s", w.record.nailing_end)) }
+                    td { a href=(scenes(i)) { "scene" } }
+                }
+            }
+        }
+    }
+}
+
+fn causes(w: &WallView) -> Markup {
+    html! {
+        div class="causes" data-wall=(w.row.wall_id) {
+            h3 { "Root causes in " (w.row.name) }
+            @if w.causes.is_empty() { p { "None: every piece placed and every nail driven." } }
+            ul {
+                @for c in &w.causes {
+                    li data-id=(c.piece) {
+                        strong { (c.component) } " (" (c.stage) ") " (c.piece) ": " (c.message)
+                        @if !c.consequences.is_empty() {
+                            details {
+                                summary { "and " (c.consequences.len()) (if c.consequences.len() == 1 { " consequence" } else { " consequences" }) }
+                                ul { @for q in &c.consequences { li { (q.message) } } }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
+    let index = input
+        .report
+        .walls
+        .iter()
+        .position(|r| r.wall_id == w.row.wall_id)
+        .unwrap_or(0);
+    let thickness = input
+        .sim
+        .plan
+        .walls
+        .iter()
+        .find(|p| p.id == w.row.wall_id)
+        .map_or(0.09, |p| p.thickness);
+    let contacts: Vec<_> = input
+        .report
+        .contacts
+        .iter()
+        .filter(|c| c.wall_id == w.row.wall_id)
+        .collect();
+    html! {
+        section class="wall" id=(format!("wall-{}", index + 1)) data-wall=(w.row.wall_id) {
+            h2 { (w.row.name) " (" (w.row.wall_id) ")" }
+            p { "3D scene of the run: " a href=(scene) { (scene) } " (glTF 2.0; opens in any glTF viewer)." }
+            h3 { "Elevation" }
+            p { "Wall frame: u along the wall, v up; hover a piece for its IFC name, entity and reason." }
+            (svg::elevation(w))
+            (causes(w))
+            h3 { "Cell from above" }
+            p { "The wall laid on the assembly area; the dashed circle is the grip's reach straight down at the assembly surface." }
+            (svg::plan_view(input.cell, w, thickness))
+            h3 { "Timeline" }
+            p { (format!("Framing {:.1} s, nailing {:.1} s.", w.record.framing_end, w.record.nailing_end - w.record.framing_end)) }
+            (svg::timeline(w))
+            h3 { "Contacts" }
+            @if contacts.is_empty() { p { "The robot touched nothing it should not have." } }
+            @else {
+                table class="contacts" {
+                    tr { th { "t (s)" } th { "body" } th { "touched" } th { "depth (mm)" } th { "during" } th { "of" } }
+                    @for c in contacts {
+                        tr { td class="num" { (format!("{:.2}", c.t)) } td { (c.body_a) } td { (c.body_b) } td class="num" { (format!("{:.1}", c.depth_mm)) } td { (c.op) } td { (c.element) } }
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn validation(report: &SimReport) -> Markup {
+    let v = &report.nailing_validation;
+    html! {
+        h2 { "Nailing validation" }
+        p { (format!("{} of {} nails driven and checked against the as-built pieces; largest error {:.2} mm ({:.2} %); ", v.checked, v.planned, v.max_error_mm, v.max_error_pct))
+            (if v.all_inside_members { "every nail runs into its member." } else { "some nails miss their member." }) }
+        table class="nails" {
+            tr { th { "wall" } th { "plate" } th { "member" } th { "k" } th { "planned u, v, w (m)" } th { "as built (m)" } th { "error (mm)" } th { "status" } }
+            @for t in &v.targets {
+                tr {
+                    td { (t.wall_id) } td { (t.plate) } td { (t.member) } td class="num" { (t.k) }
+                    td class="num" { (format!("{:.4}, {:.4}, {:.4}", t.planned[0], t.planned[1], t.planned[2])) }
+                    td class="num" { @if let Some(b) = t.as_built { (format!("{:.4}, {:.4}, {:.4}", b[0], b[1], b[2])) } @else { "–" } }
+                    td class="num" { @if let Some(e) = t.error_mm { (format!("{e:.2}")) } @else { "–" } }
+                    td { (t.status) }
+                }
+            }
+        }
+    }
+}
+
+/// Writes the report's files into `dir`: built in a fresh temporary folder beside it, then
+/// renamed into place (an existing `dir` is replaced only once the new one is complete).
+pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
+    let files = report_files(input);
+    let parent = match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = dir
+        .file_name()
+        .ok_or_else(|| std::io::Error::other("the report path names no folder"))?
+        .to_string_lossy()
+        .into_owned();
+    let tmp = parent.join(format!(".{name}.{}.tmp", std::process::id()));
+    let old = parent.join(format!(".{name}.{}.old", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    let result = (|| {
+        std::fs::create_dir(&tmp)?;
+        for (file, bytes) in &files {
+            std::fs::write(tmp.join(file), bytes)?;
+        }
+        if dir.exists() {
+            // Replace only an earlier report (or an empty folder), never other files.
+            let empty = std::fs::read_dir(dir)?.next().is_none();
+            if !empty && !dir.join("index.html").exists() {
+                return Err(std::io::Error::other(
+                    "the folder exists and holds no earlier report; name a new folder",
+                ));
+            }
+            std::fs::rename(dir, &old)?;
+            std::fs::rename(&tmp, dir)?;
+            std::fs::remove_dir_all(&old)
+        } else {
+            std::fs::rename(&tmp, dir)
+        }
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
+}
