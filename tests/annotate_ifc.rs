@@ -350,8 +350,16 @@ fn simulate_verdicts_agree_with_the_simulate_report() {
     let dir = tempfile::tempdir().unwrap();
     let model = root().join("examples/models/tm1.ifc");
     let out = dir.path().join("out.ifc");
-    let output = annotate(&model, &out, &["--simulate"]);
-    let report = framewright(&["simulate", model.to_str().unwrap(), "--json"]);
+    // TM1 laid where the study laid TM3 (0.531 m): its bottom plate is out of the arm's
+    // range, so a failed element's reason is checked too.
+    let output = annotate(&model, &out, &["--simulate", "--offset-x", "0.531"]);
+    let report = framewright(&[
+        "simulate",
+        model.to_str().unwrap(),
+        "--json",
+        "--offset-x",
+        "0.531",
+    ]);
     let report: serde_json::Value = serde_json::from_slice(&report.stdout).unwrap();
     let f = read(&output);
     // Property name → value text, per element GlobalId (one-piece products here).
@@ -418,5 +426,5 @@ fn simulate_verdicts_agree_with_the_simulate_report() {
             assert_eq!(props["Reason"], line, "{gid}");
         }
     }
-    assert!(failed > 0, "TM1 on the study cell fails its bottom plate");
+    assert!(failed > 0, "TM1 at x = 0.531 m fails its bottom plate");
 }

@@ -36,7 +36,13 @@ fn study_cells_load_with_the_study_numbers() {
         // Conveyor 1 feeds conveyor 2 from the side: it runs across conveyor 2 and ends at
         // conveyor 2's near edge.
         assert_eq!(cell.arrangement, framewright::cell::Arrangement::SideBySide);
-        assert!(cell.conveyor1.direction().dot(&cell.conveyor2.direction()).abs() < 1e-9);
+        assert!(
+            cell.conveyor1
+                .direction()
+                .dot(&cell.conveyor2.direction())
+                .abs()
+                < 1e-9
+        );
         let to_centre_line = (cell.conveyor2.pose.translation.vector
             - cell.conveyor1.downstream_end().coords)
             .dot(&cell.conveyor1.direction());

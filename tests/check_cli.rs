@@ -243,6 +243,8 @@ fn simulate_gives_rules_the_executor_facts() {
         "--rules",
         s(&f),
         "--simulate",
+        "--offset-x",
+        "0.531",
         "--wall",
         "W1",
         "--json",

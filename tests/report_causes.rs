@@ -21,8 +21,12 @@ fn run(name: &str, walls: &[&str]) -> (framewright::sim::Simulation, SimReport) 
         walls: walls.iter().map(|w| w.to_string()).collect(),
         ..SimOptions::default()
     };
-    let sim =
-        simulate(&model, &Cell::load("study-abb").unwrap(), &options).expect("simulation runs");
+    // Walls where the study laid its TM3 (0.531 m from the base), lumber end to end: TM1's
+    // bottom plate is then out of the arm's range.
+    let mut cell = Cell::load("study-abb").unwrap();
+    cell.set_offset_x("0.531").unwrap();
+    cell.arrangement = framewright::cell::Arrangement::EndToEnd;
+    let sim = simulate(&model, &cell, &options).expect("simulation runs");
     let report = SimReport::new(&sim, options.dt);
     (sim, report)
 }

@@ -40,10 +40,26 @@ fn bad(args: &[&str]) -> String {
 fn why_json_has_the_element_its_verdicts_and_complete_trees() {
     let m = tm3();
     let m = m.to_str().unwrap();
-    let text = ok(&["why", m, "#174", "--json", "--no-simulate"]);
+    let text = ok(&[
+        "why",
+        "--offset-x",
+        "0.531",
+        m,
+        "#174",
+        "--json",
+        "--no-simulate",
+    ]);
     assert_eq!(
         text,
-        ok(&["why", m, "#174", "--json", "--no-simulate"]),
+        ok(&[
+            "why",
+            "--offset-x",
+            "0.531",
+            m,
+            "#174",
+            "--json",
+            "--no-simulate"
+        ]),
         "deterministic"
     );
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();

@@ -12,6 +12,14 @@ use nalgebra::Vector3;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// The shipped cell as the study laid its TM3 (bottom plate 0.531 m from the base) with
+/// lumber end to end on conveyor 1: the fixed layout these tests were written against.
+fn pinned(mut cell: Cell) -> Cell {
+    cell.set_offset_x("0.531").unwrap();
+    cell.arrangement = framewright::cell::Arrangement::EndToEnd;
+    cell
+}
+
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
@@ -63,7 +71,7 @@ fn scene(model: &str, cell: &Cell) -> Scene {
 
 #[test]
 fn spawn_order_is_the_assembly_order() {
-    let cell = Cell::load("study-abb").unwrap();
+    let cell = pinned(Cell::load("study-abb").unwrap());
     for name in ["tm1.ifc", "tm3.ifc"] {
         let model = Model::open(example(name)).unwrap();
         let expected = expected_order(&model, &cell);
@@ -95,7 +103,7 @@ fn spawn_order_is_the_assembly_order() {
 /// End to end against the truth sidecars: each wall's pieces spawn in the truth's assembly order.
 #[test]
 fn spawn_order_matches_the_truth_assembly_order() {
-    let cell = Cell::load("study-abb").unwrap();
+    let cell = pinned(Cell::load("study-abb").unwrap());
     for name in ["tm1.ifc", "tm2.ifc", "tm3.ifc"] {
         let truth: serde_json::Value = serde_json::from_str(
             &std::fs::read_to_string(example(&name.replace(".ifc", ".truth.json"))).unwrap(),
@@ -125,7 +133,7 @@ fn spawn_order_matches_the_truth_assembly_order() {
 #[test]
 fn pieces_follow_each_other_with_150_mm_gaps_standing_on_a_narrow_face() {
     for cell_name in ["study-abb", "study-kuka"] {
-        let cell = Cell::load(cell_name).unwrap();
+        let cell = pinned(Cell::load(cell_name).unwrap());
         let s = scene("tm3.ifc", &cell);
         let belt = cell.conveyor1;
         let dir = belt.direction();
@@ -217,7 +225,7 @@ fn pieces_follow_each_other_with_150_mm_gaps_standing_on_a_narrow_face() {
 
 #[test]
 fn masses_are_volume_times_density() {
-    let cell = Cell::load("study-abb").unwrap();
+    let cell = pinned(Cell::load("study-abb").unwrap());
     let model = Model::open(example("tm3.ifc")).unwrap();
     let s = scene("tm3.ifc", &cell);
     for p in &s.pieces {
@@ -248,7 +256,7 @@ fn masses_are_volume_times_density() {
 
 #[test]
 fn framing_targets_of_the_scene_are_the_rule_targets() {
-    let cell = Cell::load("study-abb").unwrap();
+    let cell = pinned(Cell::load("study-abb").unwrap());
     let model = Model::open(example("tm1.ifc")).unwrap();
     let r = Scene::reason(&model, &cell, &RuleEngine::Compiled).unwrap();
     let targets = framewright::world::framing_targets(&r).unwrap();
@@ -264,7 +272,7 @@ fn framing_targets_of_the_scene_are_the_rule_targets() {
 #[test]
 fn json_is_byte_identical_across_runs() {
     for cell_name in ["study-abb", "study-kuka"] {
-        let cell = Cell::load(cell_name).unwrap();
+        let cell = pinned(Cell::load(cell_name).unwrap());
         let a = json::to_json(&scene("tm3.ifc", &cell));
         let b = json::to_json(&scene("tm3.ifc", &cell));
         assert_eq!(a, b);
@@ -277,7 +285,7 @@ fn json_is_byte_identical_across_runs() {
 /// The interpreter gives the same scene as the compiled rules.
 #[test]
 fn engines_agree_on_the_scene() {
-    let cell = Cell::load("study-abb").unwrap();
+    let cell = pinned(Cell::load("study-abb").unwrap());
     let model = Model::open(example("tm3.ifc")).unwrap();
     let compiled = Scene::reason(&model, &cell, &RuleEngine::Compiled).unwrap();
     let interpreted = Scene::reason(&model, &cell, &RuleEngine::Interpreted).unwrap();
@@ -293,7 +301,7 @@ fn shared_test_cases_build_scenes() {
     let Some(dir) = common::shared_path("ifc-testcases") else {
         return;
     };
-    let cell = Cell::load("study-abb").unwrap();
+    let cell = pinned(Cell::load("study-abb").unwrap());
     for name in [
         "a_paper_tm1.ifc",
         "a_paper_tm3.ifc",
@@ -325,7 +333,7 @@ fn shared_test_cases_build_scenes() {
 /// Pieces longer than conveyor 1 are named in a warning.
 #[test]
 fn pieces_longer_than_the_belt_are_warned_about() {
-    let mut cell = Cell::load("study-abb").unwrap();
+    let mut cell = pinned(Cell::load("study-abb").unwrap());
     cell.conveyor1.length = 0.95;
     let s = scene("tm1.ifc", &cell);
     let long: Vec<&str> = s
@@ -350,7 +358,7 @@ fn headers_lie_flat_at_their_targets() {
     let Some(path) = common::shared_path("ifc-testcases/d_wall_door.ifc") else {
         return;
     };
-    let cell = Cell::load("study-abb").unwrap();
+    let cell = pinned(Cell::load("study-abb").unwrap());
     let s = Scene::from_model_file(&path, &cell).unwrap();
     let flat: Vec<&ScenePiece> = s.pieces.iter().filter(|p| !p.on_edge).collect();
     assert!(!flat.is_empty());

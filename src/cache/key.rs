@@ -89,6 +89,7 @@ mod tests {
         let model = Model::open(&path).unwrap();
         let mut facts = model_facts(&model, &ContactOptions::default());
         facts.extend(cell_facts(cell));
+        crate::frame::placement::add_placement_facts(&mut facts, cell, &options.engine).unwrap();
         let reasoned = reason(&facts, &options.engine, false).unwrap();
         let scene = Scene::build("tm3.ifc", &model, cell, &reasoned).unwrap();
         let plan = plan::Plan::from_reasoned(&model, &reasoned);

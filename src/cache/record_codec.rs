@@ -116,6 +116,7 @@ enum IkFailureBits {
     WristSingularity(u64, u64),
     AllSolutionsCollide([String; 2]),
     NoExactSolution(u64, u64),
+    BranchJump(String, u64, u64),
     InvalidPose,
 }
 
@@ -171,6 +172,9 @@ impl From<&IkFailure> for IkFailureBits {
                 position_error,
                 rotation_error,
             } => IkFailureBits::NoExactSolution(bits(*position_error), bits(*rotation_error)),
+            IkFailure::BranchJump { joint, jump, at } => {
+                IkFailureBits::BranchJump(joint.clone(), bits(*jump), bits(*at))
+            }
             IkFailure::InvalidPose => IkFailureBits::InvalidPose,
         }
     }
@@ -195,6 +199,11 @@ impl IkFailureBits {
                 required: float(r),
             },
             IkFailureBits::AllSolutionsCollide(pair) => IkFailure::AllSolutionsCollide { pair },
+            IkFailureBits::BranchJump(joint, j, a) => IkFailure::BranchJump {
+                joint,
+                jump: float(j),
+                at: float(a),
+            },
             IkFailureBits::NoExactSolution(p, r) => IkFailure::NoExactSolution {
                 position_error: float(p),
                 rotation_error: float(r),
@@ -348,6 +357,9 @@ impl Rec {
             });
         }
         Some(WallRecord {
+            // The pose trace (for the report's animation) is not cached: `simulate --report`
+            // simulates every wall.
+            trace: Default::default(),
             wall: self.wall,
             operations,
             ik,
@@ -414,6 +426,7 @@ mod tests {
 
     fn sample() -> WallRecord {
         WallRecord {
+            trace: Default::default(),
             wall: "2Ab$x".into(),
             operations: vec![Operation {
                 piece: "p1".into(),

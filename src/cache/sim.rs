@@ -87,6 +87,7 @@ fn prepare(
     check_options(options)?;
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
+    crate::frame::placement::add_placement_facts(&mut facts, cell, &options.engine)?;
     let planned = reason(&facts, &options.engine, false)?;
     let scene = Scene::build(model_name, model, cell, &planned)?;
     let plan = Plan::from_reasoned(model, &planned);

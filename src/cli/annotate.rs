@@ -40,7 +40,7 @@ pub struct AnnotateArgs {
 
 pub fn run(args: AnnotateArgs) -> CmdResult {
     let inputs = &args.inputs;
-    let (model, cell, facts) = load_inputs(&args.model, &inputs.cell, inputs.contact_tolerance)?;
+    let (model, cell, facts) = load_inputs(&args.model, inputs)?;
     let engine = rule_base(&inputs.rules_dir);
     let (plan, verdicts) = if args.simulate {
         let options = SimOptions {

@@ -56,6 +56,7 @@ pub fn plan_and_report(
     }
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
+    framewright::frame::placement::add_placement_facts(&mut facts, cell, &RuleEngine::Compiled)?;
     let reasoned = reason(&facts, &RuleEngine::Compiled, false)?;
     Ok((Plan::from_reasoned(model, &reasoned), None))
 }

@@ -87,7 +87,12 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     );
     let bars = Bars::new();
     let progress = |wall: &str, done, total| bars.update(wall, done, total);
-    let cache = args.cache.open();
+    // The report animates every wall from its pose trace, which the cache does not keep.
+    let cache = if args.report.is_some() {
+        None
+    } else {
+        args.cache.open()
+    };
     if let Some(shard) = args.shard {
         let Some(cache) = &cache else {
             return Err(super::Failure::bad_input(

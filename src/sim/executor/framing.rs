@@ -299,7 +299,10 @@ impl<'a> WallRun<'a> {
         let mut best: Option<(f64, FramingPlan)> = None;
         let mut miss: Option<(f64, &'static str, IkFailure)> = None;
         let mut note_miss = |op, f: IkFailure| {
-            let score = failure_score(&f);
+            // A grip whose pick fails got less far than one whose place fails: report the
+            // place miss when there is one (a long plate's middle may lie beyond reach on the
+            // belt, but that is not why it cannot be framed).
+            let score = failure_score(&f) + if op == "pick" { 100.0 } else { 0.0 };
             if miss.as_ref().is_none_or(|m| score < m.0) {
                 miss = Some((score, op, f));
             }
