@@ -181,7 +181,7 @@ fn the_top_plate_failed_framing_because_its_place_pose_is_beyond_reach() {
     assert!(
         s.rules
             .iter()
-            .any(|r| r.starts_with("target_wall_parallel (rules/targets.dl:"))
+            .any(|r| r.starts_with("wall_laid_flat_parallel (rules/targets.dl:"))
     );
     assert!(
         s.rules
@@ -229,7 +229,7 @@ fn the_text_tree_shows_the_numbers_the_rules_and_the_ifc_ids() {
         ),
         "{text}"
     );
-    assert!(text.contains("IFC #24 #35 #38 #44 #171 #174; cell keys: assembly_centre_y, assembly_offset_x, assembly_orientation, assembly_surface_z; 1 simulation facts"), "{text}");
+    assert!(text.contains("IFC #24 #35 #38 #44 #171 #174; cell keys: assembly_centre_y, assembly_offset, assembly_offset_x, assembly_orientation, assembly_surface_z; 1 simulation facts"), "{text}");
     // Deep trees are cut on a terminal with a count, never silently.
     assert!(text.contains("more facts below (--json has the whole tree)"));
     // Widest first: under the reason, the framing target (most facts) comes before the role.

@@ -219,11 +219,11 @@ fn cell_facts_hold_the_documented_keys() {
         ("assembly_offset_x", 0.531),
         ("assembly_centre_y", 0.0),
         ("assembly_surface_z", 0.0),
-        ("conveyor1_x", -1.30),
-        ("conveyor1_y", 11.20),
+        ("conveyor1_x", -5.45),
+        ("conveyor1_y", 3.45),
         ("conveyor1_z", 0.80),
         ("conveyor1_length", 8.0),
-        ("conveyor1_width", 0.30),
+        ("conveyor1_width", 7.5),
         ("conveyor1_speed", 0.05),
         ("conveyor1_lumber_gap", 0.150),
         ("conveyor2_speed", 2.0),
@@ -237,7 +237,8 @@ fn cell_facts_hold_the_documented_keys() {
             values[key]
         );
     }
-    assert!((values["conveyor1_yaw"] + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    // The infeed deck runs towards +x, across conveyor 2.
+    assert!(values["conveyor1_yaw"].abs() < 1e-12);
     assert_eq!(choices["assembly_orientation"], "parallel");
     assert_eq!(choices["cell_name"], "study-abb");
 }
