@@ -9,7 +9,10 @@ use crate::frame::plan::Plan;
 use crate::frame::{Facts, Reasoned, cell_facts, model_facts, reason};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
-use crate::sim::{SimError, SimOptions, Simulation, WallRecord, simulate_with_progress};
+use crate::sim::{
+    SimError, SimOptions, Simulation, WallRecord, check_options, select_walls,
+    simulate_with_progress,
+};
 use crate::world::Scene;
 use serde::Serialize;
 
@@ -284,59 +287,6 @@ fn simulate_misses(
         }
     }
     Ok(records)
-}
-
-/// The option checks of `simulate`, made before anything is read from the cache.
-fn check_options(options: &SimOptions) -> Result<(), SimError> {
-    if !(options.dt > 0.0 && options.dt <= 0.05) {
-        return Err(SimError::Option(format!(
-            "the time step must be in (0, 0.05] s, not {}",
-            options.dt
-        )));
-    }
-    if !(options.speed > 0.0 && options.speed <= 1.0) {
-        return Err(SimError::Option(format!(
-            "the speed fraction must be in (0, 1], not {}",
-            options.speed
-        )));
-    }
-    Ok(())
-}
-
-/// The key pieces of the walls to run: all, or those named by id, name or key, in plan
-/// order (as `simulate` selects them).
-fn select_walls(plan: &Plan, wanted: &[String]) -> Result<Vec<String>, SimError> {
-    if plan.walls.is_empty() {
-        let reason = if plan.warnings.is_empty() {
-            String::new()
-        } else {
-            format!(": {}", plan.warnings.join("; "))
-        };
-        return Err(SimError::NoWalls { reason });
-    }
-    let mut keys = Vec::new();
-    for name in wanted {
-        let wall = plan
-            .walls
-            .iter()
-            .find(|w| &w.id == name || &w.name == name || &w.key == name)
-            .ok_or_else(|| SimError::UnknownWall {
-                name: name.clone(),
-                known: plan
-                    .walls
-                    .iter()
-                    .map(|w| format!("{} ({})", w.name, w.id))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })?;
-        keys.push(wall.key.clone());
-    }
-    Ok(plan
-        .walls
-        .iter()
-        .filter(|w| wanted.is_empty() || keys.contains(&w.key))
-        .map(|w| w.key.clone())
-        .collect())
 }
 
 #[cfg(test)]

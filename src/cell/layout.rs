@@ -709,19 +709,11 @@ fn base_clearance(robot: &Robot) -> f64 {
     let poses = robot.fk_all(&q);
     // The base and the links carried by the first joint only (they turn about the base axis):
     // links with at most one moving joint between them and the root.
-    let moving_joints_above = |mut link: usize| {
-        let mut n = 0;
-        while let Some(j) = robot.links[link].parent_joint {
-            n += usize::from(robot.joints[j].dof_index.is_some());
-            link = robot.joints[j].parent;
-        }
-        n
-    };
     let radius = robot
         .links
         .iter()
         .enumerate()
-        .filter(|(i, _)| moving_joints_above(*i) <= 1)
+        .filter(|(i, _)| super::tcp_poses::moving_joints_above(robot, *i) <= 1)
         .flat_map(|(i, link)| link.collisions.iter().map(move |c| (i, c)))
         .map(|(i, c)| {
             let centre = (poses[i] * c.origin).translation.vector;

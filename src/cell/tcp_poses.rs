@@ -2,6 +2,7 @@
 //! centre of mass, the nailer on a nail line, and how low the arm and its tool reach.
 
 use super::layout::Cell;
+use super::robot::Robot;
 use super::shapes::{PlacedShape, Shape};
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
@@ -78,20 +79,12 @@ pub fn centre_grip(body: &Isometry3<f64>, size: &[f64; 3], flip: bool) -> Option
 pub fn lowest_point(cell: &Cell, q: &[f64]) -> f64 {
     let robot = &cell.robot;
     let poses = robot.fk_all(q);
-    let moving_joints_above = |mut link: usize| {
-        let mut n = 0;
-        while let Some(j) = robot.links[link].parent_joint {
-            n += usize::from(robot.joints[j].dof_index.is_some());
-            link = robot.joints[j].parent;
-        }
-        n
-    };
     let poses = &poses;
     let links = robot
         .links
         .iter()
         .enumerate()
-        .filter(|(i, _)| moving_joints_above(*i) > 1)
+        .filter(|(i, _)| moving_joints_above(robot, *i) > 1)
         .flat_map(|(i, link)| {
             link.collisions
                 .iter()
@@ -100,6 +93,17 @@ pub fn lowest_point(cell: &Cell, q: &[f64]) -> f64 {
     let tool = cell.robot_base * poses[robot.tip];
     let parts = cell.tool.parts.iter().map(|p| lowest(&tool, &p.shape));
     links.chain(parts).fold(f64::INFINITY, f64::min)
+}
+
+/// How many moving joints lie between a link and the robot's root (0 for the base, 1 for the
+/// turntable on it).
+pub fn moving_joints_above(robot: &Robot, mut link: usize) -> usize {
+    let mut n = 0;
+    while let Some(j) = robot.links[link].parent_joint {
+        n += usize::from(robot.joints[j].dof_index.is_some());
+        link = robot.joints[j].parent;
+    }
+    n
 }
 
 /// The lowest z of a placed shape whose owner is at `owner`.

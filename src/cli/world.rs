@@ -2,10 +2,10 @@
 //! model on a cell, as a JSON scene or a Webots R2023b world. The output is written to a
 //! temporary file beside PATH and renamed over it, so a failure never leaves half a file.
 
+use super::write_atomically;
 use super::{CmdResult, Failure, print_stdout};
 use framewright::cell::Cell;
 use framewright::world::{Scene, json, wbt};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -59,30 +59,4 @@ pub fn run(args: WorldArgs) -> CmdResult {
         ))
     })?;
     Ok(ExitCode::SUCCESS)
-}
-
-/// Writes `bytes` to a temporary file in `path`'s directory, then renames it over `path`.
-fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::other("the output path names no file"))?;
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

@@ -86,18 +86,7 @@ pub fn simulate_with_progress(
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<Simulation, SimError> {
     use rayon::prelude::*;
-    if !(options.dt > 0.0 && options.dt <= 0.05) {
-        return Err(SimError::Option(format!(
-            "the time step must be in (0, 0.05] s, not {}",
-            options.dt
-        )));
-    }
-    if !(options.speed > 0.0 && options.speed <= 1.0) {
-        return Err(SimError::Option(format!(
-            "the speed fraction must be in (0, 1], not {}",
-            options.speed
-        )));
-    }
+    check_options(options)?;
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
     crate::frame::placement::add_placement_facts(&mut facts, cell, &options.engine)?;
@@ -138,9 +127,26 @@ pub fn simulate_with_progress(
     })
 }
 
+/// The option checks of `simulate`: a time step in (0, 0.05] s, a speed fraction in (0, 1].
+pub fn check_options(options: &SimOptions) -> Result<(), SimError> {
+    if !(options.dt > 0.0 && options.dt <= 0.05) {
+        return Err(SimError::Option(format!(
+            "the time step must be in (0, 0.05] s, not {}",
+            options.dt
+        )));
+    }
+    if !(options.speed > 0.0 && options.speed <= 1.0) {
+        return Err(SimError::Option(format!(
+            "the speed fraction must be in (0, 1], not {}",
+            options.speed
+        )));
+    }
+    Ok(())
+}
+
 /// The keys (rule-base wall ids) of the walls to run: all, or those named (by id, name or
 /// key), in plan order.
-fn select_walls(plan: &Plan, wanted: &[String]) -> Result<Vec<String>, SimError> {
+pub fn select_walls(plan: &Plan, wanted: &[String]) -> Result<Vec<String>, SimError> {
     let with_pieces: Vec<&crate::frame::plan::Wall> = plan.walls.iter().collect();
     if with_pieces.is_empty() {
         let reason = if plan.warnings.is_empty() {
