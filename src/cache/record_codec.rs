@@ -117,6 +117,7 @@ enum IkFailureBits {
     AllSolutionsCollide([String; 2]),
     NoExactSolution(u64, u64),
     BranchJump(String, u64, u64),
+    PathBlocked([String; 2]),
     InvalidPose,
 }
 
@@ -168,6 +169,7 @@ impl From<&IkFailure> for IkFailureBits {
             IkFailure::AllSolutionsCollide { pair } => {
                 IkFailureBits::AllSolutionsCollide(pair.clone())
             }
+            IkFailure::PathBlocked { pair } => IkFailureBits::PathBlocked(pair.clone()),
             IkFailure::NoExactSolution {
                 position_error,
                 rotation_error,
@@ -199,6 +201,7 @@ impl IkFailureBits {
                 required: float(r),
             },
             IkFailureBits::AllSolutionsCollide(pair) => IkFailure::AllSolutionsCollide { pair },
+            IkFailureBits::PathBlocked(pair) => IkFailure::PathBlocked { pair },
             IkFailureBits::BranchJump(joint, j, a) => IkFailure::BranchJump {
                 joint,
                 jump: float(j),

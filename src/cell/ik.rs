@@ -40,6 +40,9 @@ pub enum IkFailure {
     /// A straight TCP line leaves every IK branch it starts on: following the branch,
     /// `joint` would jump `jump` (rad or m) between two samples, `at` (0..1) of the way along.
     BranchJump { joint: String, jump: f64, at: f64 },
+    /// Both ends of a move are reachable and clear, but no collision-free path between them
+    /// was found (filled by the executor's planner): the pair of bodies on the direct path.
+    PathBlocked { pair: [String; 2] },
     /// The pose has NaN or infinite numbers.
     InvalidPose,
 }
@@ -82,6 +85,11 @@ impl std::fmt::Display for IkFailure {
                 f,
                 "no continuous solution along the straight line: {joint} would jump {jump:.3} between two poses {:.0} % of the way",
                 at * 100.0
+            ),
+            IkFailure::PathBlocked { pair } => write!(
+                f,
+                "no collision-free path to the pose: {} runs into {} on the direct path and the planner found no way around",
+                pair[0], pair[1]
             ),
             IkFailure::InvalidPose => write!(f, "the pose is not finite"),
         }

@@ -8,6 +8,7 @@
 mod executor;
 mod motion;
 mod physics;
+pub mod planner;
 mod reach;
 pub mod record;
 

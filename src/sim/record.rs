@@ -224,6 +224,12 @@ pub fn failure_columns(f: &IkFailure) -> (&'static str, String, f64, f64) {
             *rotation_error,
         ),
         IkFailure::BranchJump { joint, jump, at } => ("branch_jump", joint.clone(), *jump, *at),
+        IkFailure::PathBlocked { pair } => (
+            "path_blocked",
+            format!("{} / {}", pair[0], pair[1]),
+            0.0,
+            0.0,
+        ),
         IkFailure::InvalidPose => ("invalid_pose", String::new(), 0.0, 0.0),
     }
 }

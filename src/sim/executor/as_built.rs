@@ -14,7 +14,8 @@ impl<'a> WallRun<'a> {
     pub(super) fn settle(&mut self) {
         let home = self.cell.robot.home();
         let tcp = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
-        self.move_to(&home, &tcp, &[], self.transfer_speed());
+        // A way home that is blocked leaves the arm where it is: nothing left to build.
+        let _ = self.move_to(&home, &tcp, &[], self.transfer_speed());
         self.wait(SETTLE_TIME);
     }
 

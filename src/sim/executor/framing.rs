@@ -109,12 +109,17 @@ impl<'a> WallRun<'a> {
         if let Some(current) = &mut self.current {
             current.2.clear();
         }
-        self.move_to(
+        if let Err(failure) = self.move_to(
             &plan.q_above_pick.clone(),
             &grip,
             &[],
             self.transfer_speed(),
-        );
+        ) {
+            self.record_line_failure(piece, "pick", failure);
+            self.end(id, "pick", start);
+            self.take_off(id);
+            return;
+        }
         if let Some(current) = &mut self.current {
             current.2.push(format!("piece {id}"));
         }
@@ -209,8 +214,17 @@ impl<'a> WallRun<'a> {
 
         // Move above the target.
         let start = self.begin(id, "move", &[]);
-        if ok {
-            self.move_to(&q_above_place, &grip, &[], self.transfer_speed());
+        if ok && let Err(failure) = self.move_to(&q_above_place, &grip, &[], self.transfer_speed())
+        {
+            // No way to the target with the piece: the arm lets go where it is and the piece
+            // is taken out of the cell.
+            self.record_line_failure(piece, "place", failure);
+            self.phys.set_jaws(None);
+            self.phys.detach(id);
+            self.held = None;
+            self.end(id, "move", start);
+            self.take_off(id);
+            return;
         }
         self.end(id, "move", start);
 

@@ -132,7 +132,12 @@ impl<'a> WallRun<'a> {
             };
             let plate = nail.plate.clone();
             let start = self.begin(&plate, "nail", &[nail.member.as_str()]);
-            self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed());
+            if let Err(failure) = self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()) {
+                self.end(&plate, "nail", start);
+                let (kind, what, value, limit) = failure_columns(&failure);
+                self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
+                continue;
+            }
             let reached = self
                 .run_line(
                     &LinearMove::new(

@@ -1,7 +1,9 @@
 //! Joint motion between poses that keeps the arm, its tool and a held piece clear of the cell.
 
 use super::WallRun;
+use crate::cell::IkFailure;
 use crate::sim::motion::JointMove;
+use crate::sim::planner::{self, Budget, sampling_bounds};
 use crate::sim::reach::{solve, touches};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
@@ -12,24 +14,43 @@ pub(super) const PATH_MARGIN: f64 = 0.005;
 pub(super) const MARGIN_TAPER: f64 = 0.05;
 /// Largest travel of any point of the arm between two checked samples of a move (m).
 pub(super) const SWEEP_STEP: f64 = 0.02;
+/// Joint travel (rad) over which the planner's clearance grows from nothing at a move's ends
+/// to PATH_MARGIN.
+const END_TAPER: f64 = 0.05;
+
+/// What the planner may spend on one move that the direct path and the simple detours do
+/// not solve: a coarse search first, then a finer one with another seed.
+const PLANNER_TRIES: [Budget; 2] = [
+    Budget {
+        samples: 1500,
+        step: 0.08,
+    },
+    Budget {
+        samples: 3000,
+        step: 0.04,
+    },
+];
 
 impl<'a> WallRun<'a> {
-    /// A collision-checked joint move from the current joints to `to`: straight in joint
-    /// space if that is clear, else over the highest of a few raised waypoints that are; if
-    /// none is clear, straight (the contacts are then recorded as they happen).
+    /// A collision-free joint move from the current joints to `to`: straight in joint space
+    /// if that is clear, else over an arc or raised waypoints (the moves a robot programmer
+    /// would teach), else along a path RRT-Connect finds. If none is found, the arm stays
+    /// where it is and the failure names the pair of bodies that block the direct path:
+    /// the executor never drives through an obstacle.
     pub(super) fn move_to(
         &mut self,
         to: &[f64],
         tcp: &Isometry3<f64>,
         ignore: &[&str],
         speed: f64,
-    ) {
+    ) -> Result<(), IkFailure> {
         let from = self.q.clone();
-        let path = self.clear_path(&from, to, tcp, ignore);
+        let path = self.clear_path(&from, to, tcp, ignore)?;
         for q in path.windows(2) {
             let mv = JointMove::new(&self.cell.robot, &q[0], &q[1], speed);
             self.run_joint(&mv);
         }
+        Ok(())
     }
 
     fn clear_path(
@@ -38,18 +59,38 @@ impl<'a> WallRun<'a> {
         to: &[f64],
         tcp: &Isometry3<f64>,
         ignore: &[&str],
-    ) -> Vec<Vec<f64>> {
+    ) -> Result<Vec<Vec<f64>>, IkFailure> {
         let direct = vec![from.to_vec(), to.to_vec()];
-        if self.path_clear(&direct, ignore) {
-            return direct;
+        let Some(blocked) = self.path_contact(&direct, ignore) else {
+            return Ok(direct);
+        };
+        if let Some(path) = self.taught_detour(from, to, tcp, ignore) {
+            return Ok(path);
         }
+        if let Some(path) = self.planned_detour(from, to, ignore) {
+            return Ok(path);
+        }
+        Err(IkFailure::PathBlocked {
+            pair: [blocked.0, blocked.1],
+        })
+    }
+
+    /// The detours a programmer teaches: an arc about the base that rises over the middle,
+    /// or raised waypoints over both ends (through the home pose if need be).
+    fn taught_detour(
+        &self,
+        from: &[f64],
+        to: &[f64],
+        tcp: &Isometry3<f64>,
+        ignore: &[&str],
+    ) -> Option<Vec<Vec<f64>>> {
         // An arc about the robot's base that keeps the tool's orientation turning evenly
         // (a held piece stays level) and rises over the middle.
         for bump in [0.3, 0.7] {
             if let Some(path) = self.arc(from, to, tcp, bump)
                 && self.path_clear(&path, ignore)
             {
-                return path;
+                return Some(path);
             }
         }
         let up = |q: &[f64], h: f64| -> Option<Vec<f64>> {
@@ -72,11 +113,41 @@ impl<'a> WallRun<'a> {
                 vec![from.to_vec(), a, home.clone(), b, to.to_vec()],
             ] {
                 if self.path_clear(&path, ignore) {
-                    return path;
+                    return Some(path);
                 }
             }
         }
-        direct
+        None
+    }
+
+    /// A path RRT-Connect finds in joint space, every configuration PATH_MARGIN clear (less
+    /// near the two ends, which may lie close to what they work on) and every leg checked
+    /// along its sweep. Seeded from the move itself: the same move, the same path.
+    fn planned_detour(&self, from: &[f64], to: &[f64], ignore: &[&str]) -> Option<Vec<Vec<f64>>> {
+        let held = self
+            .held
+            .as_ref()
+            .map(|h| (h.id.as_str(), &h.in_tool, h.half));
+        let bounds = sampling_bounds(&self.cell.robot.limits(), from, to);
+        let seed = move_seed(from, to);
+        PLANNER_TRIES.iter().enumerate().find_map(|(k, &budget)| {
+            let point_free = |q: &[f64]| {
+                let near_end = joint_gap(q, from).min(joint_gap(q, to));
+                let margin = PATH_MARGIN * (near_end / END_TAPER).clamp(0.0, 1.0);
+                touches(&self.phys, self.cell, q, held, ignore, margin).is_none()
+            };
+            let leg_free =
+                |a: &[f64], b: &[f64]| self.path_clear(&[a.to_vec(), b.to_vec()], ignore);
+            planner::connect(
+                from,
+                to,
+                &bounds,
+                seed.wrapping_add(k as u64),
+                budget,
+                point_free,
+                leg_free,
+            )
+        })
     }
 
     /// Joint waypoints along a TCP arc about the base from the pose at `from` to the pose at
@@ -121,10 +192,15 @@ impl<'a> WallRun<'a> {
     }
 
     /// Whether the arm sweeps along `path` (straight in joint space between waypoints) at
-    /// least PATH_MARGIN clear of everything away from its two ends: checked at samples no
-    /// further apart than SWEEP_STEP for the fastest-moving point of the arm, its tool and a
-    /// held piece.
+    /// least PATH_MARGIN clear of everything away from its two ends.
     fn path_clear(&self, path: &[Vec<f64>], ignore: &[&str]) -> bool {
+        self.path_contact(path, ignore).is_none()
+    }
+
+    /// The first pair of bodies (arm part, obstacle) closer than PATH_MARGIN along `path`,
+    /// away from its two ends: checked at samples no further apart than SWEEP_STEP for the
+    /// fastest-moving point of the arm, its tool and a held piece.
+    fn path_contact(&self, path: &[Vec<f64>], ignore: &[&str]) -> Option<(String, String)> {
         let held = self
             .held
             .as_ref()
@@ -144,13 +220,13 @@ impl<'a> WallRun<'a> {
                 let from_end = (travelled + s * length).min(total - travelled - s * length);
                 let margin = PATH_MARGIN * (from_end / MARGIN_TAPER).clamp(0.0, 1.0);
                 let q = lerp(&leg[0], &leg[1], s);
-                if touches(&self.phys, self.cell, &q, held, ignore, margin).is_some() {
-                    return false;
+                if let Some(pair) = touches(&self.phys, self.cell, &q, held, ignore, margin) {
+                    return Some(pair);
                 }
             }
             travelled += length;
         }
-        true
+        None
     }
 
     /// How far the fastest-moving of the arm's key points travels on the joint-space line
@@ -199,6 +275,24 @@ impl<'a> WallRun<'a> {
 
 fn lerp(a: &[f64], b: &[f64], s: f64) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| x + (y - x) * s).collect()
+}
+
+/// Largest single-joint difference between two configurations (rad or m).
+fn joint_gap(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+/// A seed for the planner from the move's two ends (their exact bits).
+fn move_seed(from: &[f64], to: &[f64]) -> u64 {
+    let mut hasher = blake3::Hasher::new();
+    for v in from.iter().chain(to) {
+        hasher.update(&v.to_bits().to_le_bytes());
+    }
+    let bytes = hasher.finalize();
+    u64::from_le_bytes(bytes.as_bytes()[..8].try_into().expect("32-byte hash"))
 }
 
 pub(super) fn distance(a: &[f64], b: &[f64]) -> f64 {
