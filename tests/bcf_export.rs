@@ -40,6 +40,16 @@ fn entries(bcfzip: &Path) -> Vec<(String, String)> {
     for i in 0..archive.len() {
         let mut f = archive.by_index(i).unwrap();
         let name = f.name().unwrap().to_string();
+        if name.ends_with(".png") {
+            let mut bytes = Vec::new();
+            f.read_to_end(&mut bytes).unwrap();
+            assert!(
+                bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.len() > 100,
+                "{name} is not a PNG image"
+            );
+            out.push((name, String::new()));
+            continue;
+        }
         let mut text = String::new();
         f.read_to_string(&mut text).unwrap();
         let mut reader = Reader::from_str(&text);
@@ -100,6 +110,16 @@ fn check(bcfzip: &Path, version: &str, report: &Value) -> Option<Value> {
         names.contains(&"extensions.xml".to_string()),
         version == "3.0"
     );
+    // Every topic's viewpoint carries its wall's elevation as a PNG, referenced by the markup.
+    for (name, text) in entries(bcfzip) {
+        if let Some(folder) = name.strip_suffix("/markup.bcf") {
+            assert!(
+                names.contains(&format!("{folder}/snapshot.png")),
+                "{folder} has no snapshot"
+            );
+            assert!(text.contains("<Snapshot>snapshot.png</Snapshot>"), "{text}");
+        }
+    }
     let read = read_back(bcfzip)?;
     assert_eq!(read["version"], version);
     let topics = read["topics"].as_array().unwrap();
@@ -130,7 +150,7 @@ fn check(bcfzip: &Path, version: &str, report: &Value) -> Option<Value> {
         for g in vp["selected"].as_array().unwrap() {
             assert!(visible.contains(g), "{g} selected but hidden");
         }
-        assert_eq!(vp["snapshot"], false, "no snapshot is written yet");
+        assert_eq!(vp["snapshot"], true, "the reader finds the snapshot");
         let d = vp["camera"]["direction"].as_array().unwrap();
         let norm: f64 = d.iter().map(|x| x.as_f64().unwrap().powi(2)).sum();
         assert!((norm - 1.0).abs() < 1e-5);

@@ -1,10 +1,15 @@
 //! `simulate … --bcf OUT.bcfzip [--bcf-version 3.0|2.1]`: the failing members as BCF topics.
 
 use super::{Failure, write_atomically};
+use framewright::bim::bcf::Snapshot;
 use framewright::bim::bcf::{topics_of, write_bcfzip};
 use framewright::bim::{BcfHeader, BcfVersion, iso_date_time};
 use framewright::ifc::Model;
+use framewright::report::png::svg_to_png;
+use framewright::report::simulate::SimReport;
+use framewright::report::svg::elevation_svg;
 use framewright::sim::Simulation;
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -22,7 +27,12 @@ pub struct BcfArgs {
 
 impl BcfArgs {
     /// Writes the BCF file when asked to (whole or not at all).
-    pub fn write(&self, model: &Model, sim: &Simulation) -> Result<(), Failure> {
+    pub fn write(
+        &self,
+        model: &Model,
+        sim: &Simulation,
+        report: &SimReport,
+    ) -> Result<(), Failure> {
         let Some(path) = &self.bcf else {
             return Ok(());
         };
@@ -54,7 +64,24 @@ impl BcfArgs {
             project_global_id: project,
             date: date.to_string(),
         };
-        let topics = topics_of(model, sim, &header);
+        let mut topics = topics_of(model, sim, &header);
+        // Each topic shows its wall's elevation drawing, rendered once per wall.
+        let mut snapshots: BTreeMap<String, Snapshot> = BTreeMap::new();
+        for topic in &mut topics {
+            if !snapshots.contains_key(&topic.wall_id) {
+                let Some(svg) = elevation_svg(sim, report, &topic.wall_id) else {
+                    continue;
+                };
+                let png = svg_to_png(&svg).map_err(|e| {
+                    Failure::bad_input(format!(
+                        "cannot draw the snapshot of wall {}: {e}",
+                        topic.wall_id
+                    ))
+                })?;
+                snapshots.insert(topic.wall_id.clone(), Snapshot(png));
+            }
+            topic.snapshot = snapshots.get(&topic.wall_id).cloned();
+        }
         let bytes = write_bcfzip(self.bcf_version, &header, &topics)?;
         write_atomically(path, &bytes)
             .map_err(|e| Failure::bad_input(format!("cannot write {}: {e}", path.display())))?;

@@ -115,13 +115,13 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         ),
     };
     bars.finish();
-    args.bcf.write(&model, &sim)?;
     warn_if_unwritable(cache.as_ref());
     let mut report = SimReport::new(&sim, options.dt);
     report.sim.cache = counts;
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
     }
+    args.bcf.write(&model, &sim, &report)?;
     if let Some(dir) = &args.report {
         let input = ReportInput {
             model: &model,

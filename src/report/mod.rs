@@ -7,6 +7,7 @@ pub mod html;
 pub mod inspect;
 mod mesh;
 pub mod plan;
+pub mod png;
 pub mod simulate;
 pub mod svg;
 pub mod verdict;

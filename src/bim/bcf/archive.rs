@@ -1,5 +1,5 @@
 //! The `.bcfzip`: `bcf.version`, (3.0) `extensions.xml`, and per topic a folder named by
-//! its GUID with `markup.bcf` and `viewpoint.bcfv`. Entries are stored (XML is small) with
+//! its GUID with `markup.bcf`, `viewpoint.bcfv` and `snapshot.png` (when it has one). Entries are stored (XML is small) with
 //! the zip format's fixed 1980-01-01 date, so the same topics give the same bytes.
 
 use super::topics::IssueTopic;
@@ -42,6 +42,10 @@ pub fn write_bcfzip(
         zip.write_all(&xml::markup(version, header, t)?)?;
         zip.start_file(format!("{}/viewpoint.bcfv", t.guid), options)?;
         zip.write_all(&xml::viewpoint(version, t)?)?;
+        if let Some(snapshot) = &t.snapshot {
+            zip.start_file(format!("{}/{}", t.guid, xml::SNAPSHOT_FILE), options)?;
+            zip.write_all(&snapshot.0)?;
+        }
     }
     Ok(zip.finish()?.into_inner())
 }

@@ -6,9 +6,8 @@
 //!   written with quick-xml after buildingSMART's BCF-XML schemas;
 //! - `archive`: the `.bcfzip` (stored entries, fixed dates: same inputs, same bytes).
 //!
-//! Snapshot: BCF viewpoints may carry a PNG of the issue. framewright writes none yet:
-//! the seam is [`Snapshot`], to be filled from the report's wall elevation drawing
-//! rendered to PNG once that drawing exists as a library function.
+//! Snapshot: a topic's viewpoint carries a PNG of its wall's elevation drawing (pieces
+//! coloured by verdict, nailing targets as dots; `report::png`), set by the caller.
 
 mod archive;
 mod topics;
@@ -35,8 +34,8 @@ impl BcfVersion {
     }
 }
 
-/// A viewpoint's snapshot image (PNG bytes). Not produced yet: see the module notes.
-#[derive(Debug, Clone)]
+/// A viewpoint's snapshot image (PNG bytes).
+#[derive(Debug, Clone, PartialEq)]
 pub struct Snapshot(pub Vec<u8>);
 
 /// What a BCF file is about: the model file and project, and the date its topics carry.

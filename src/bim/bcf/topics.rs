@@ -45,6 +45,8 @@ pub struct IssueTopic {
     /// IfcGuids of every element of the wall (the rest of the model hidden).
     pub wall_elements: Vec<String>,
     pub camera: Camera,
+    /// The viewpoint's image, when the caller rendered one.
+    pub snapshot: Option<super::Snapshot>,
 }
 
 /// A UUID (RFC 9562 version 8: custom, here a hash of `key`), lower-case.
@@ -197,6 +199,7 @@ pub fn topics_of(model: &Model, sim: &Simulation, header: &BcfHeader) -> Vec<Iss
                 failing,
                 wall_elements: wall_elements.clone(),
                 camera: camera.clone(),
+                snapshot: None,
             });
         };
         // Framing: one topic per element that failed on its own account.

@@ -151,10 +151,19 @@ pub fn markup(v: BcfVersion, header: &BcfHeader, t: &IssueTopic) -> io::Result<V
     })
 }
 
+/// The snapshot's file name in its topic's folder.
+pub const SNAPSHOT_FILE: &str = "snapshot.png";
+
 fn viewpoint_ref(w: &mut W, name: &str, t: &IssueTopic) -> io::Result<()> {
     w.create_element(name)
         .with_attribute(("Guid", t.viewpoint_guid.as_str()))
-        .write_inner_content(|w| text(w, "Viewpoint", "viewpoint.bcfv"))?;
+        .write_inner_content(|w| {
+            text(w, "Viewpoint", "viewpoint.bcfv")?;
+            if t.snapshot.is_some() {
+                text(w, "Snapshot", SNAPSHOT_FILE)?;
+            }
+            Ok(())
+        })?;
     Ok(())
 }
 
