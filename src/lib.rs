@@ -5,6 +5,7 @@
 //! `logic` (rule language) → `cell` (robots, tools, layouts, kinematics).
 //! See `docs/ARCHITECTURE.md` for the codemap.
 
+pub mod atomic;
 pub mod bim;
 pub mod cache;
 pub mod cell;

@@ -6,7 +6,6 @@
 use super::record_codec::Entry;
 use crate::sim::WallRecord;
 use serde::Serialize;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -94,14 +93,9 @@ fn write_atomically(path: &Path, entry: &impl Serialize) -> std::io::Result<()> 
         .parent()
         .ok_or_else(|| std::io::Error::other("an entry path has no folder"))?;
     std::fs::create_dir_all(dir)?;
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".entry-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
-    serde_json::to_writer(tmp.as_file_mut(), entry)?;
-    tmp.as_file_mut().flush()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    crate::atomic::write_atomically_with(path, |w| {
+        serde_json::to_writer(w, entry).map_err(std::io::Error::other)
+    })
 }
 
 /// What a cache folder holds.
@@ -172,7 +166,10 @@ fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
     };
     for e in top.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        if name.starts_with(WHY_PREFIX) && (name.ends_with(".json") || name.contains(".tmp")) {
+        // Temporary files of the atomic writer are `.<target name>.<random>.tmp`.
+        let leftover =
+            |prefix: &str| name.starts_with(&format!(".{prefix}")) && name.ends_with(".tmp");
+        if (name.starts_with(WHY_PREFIX) && name.ends_with(".json")) || leftover(WHY_PREFIX) {
             files.push(EntryFile {
                 path: e.path(),
                 kind: Kind::Why,
@@ -186,9 +183,7 @@ fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
             };
             for e in entries.flatten() {
                 let name = e.file_name().to_string_lossy().into_owned();
-                if name.ends_with(".json")
-                    || (name.starts_with(".entry-") && name.ends_with(".tmp"))
-                {
+                if name.ends_with(".json") || (name.starts_with('.') && name.ends_with(".tmp")) {
                     files.push(EntryFile {
                         path: e.path(),
                         kind: Kind::Wall,

@@ -21,7 +21,10 @@ pub struct InspectArgs {
 pub fn run(args: InspectArgs) -> CmdResult {
     let options = ReadOptions {
         max_bytes: args.max_size.saturating_mul(1 << 20),
-        ..ReadOptions::default()
+        ..ReadOptions::from_env().map_err(|e| framewright::ifc::IfcError {
+            path: args.model.clone(),
+            kind: e.into(),
+        })?
     };
     let model = Model::open_with(&args.model, &options)?;
     let report = InspectReport::new(&model);

@@ -19,6 +19,9 @@ pub enum RulesCommand {
         /// Explain a tuple: 'rel(a, b)' (how it was derived) or 'not rel(a, b)' (why not). Repeatable.
         #[arg(long)]
         explain: Vec<String>,
+        /// Folder every `.include` must stay in (default: the program file's folder).
+        #[arg(long)]
+        rules_dir: Option<PathBuf>,
         /// Stop when the relations hold more tuples than this.
         #[arg(long, default_value_t = Limits::default().max_tuples)]
         max_tuples: usize,
@@ -27,7 +30,12 @@ pub enum RulesCommand {
         max_iterations: usize,
     },
     /// Check a rule program without running it.
-    Check { program: PathBuf },
+    Check {
+        program: PathBuf,
+        /// Folder every `.include` must stay in (default: the program file's folder).
+        #[arg(long)]
+        rules_dir: Option<PathBuf>,
+    },
     /// Print the reference of the built-in relations (docs/RELATIONS.md) as Markdown.
     Relations,
 }
@@ -40,8 +48,8 @@ pub fn run(cmd: RulesCommand) -> CmdResult {
                 &base,
             ))
         }
-        RulesCommand::Check { program } => {
-            let p = Program::parse_files(&[&program])?;
+        RulesCommand::Check { program, rules_dir } => {
+            let p = Program::parse_files_within(&[&program], rules_dir.as_deref())?;
             print_stdout(&format!(
                 "{}: ok ({} relations, {} rules and facts, {} strata)\n",
                 program.display(),
@@ -55,10 +63,14 @@ pub fn run(cmd: RulesCommand) -> CmdResult {
             facts,
             out,
             explain,
+            rules_dir,
             max_tuples,
             max_iterations,
         } => {
-            let p = std::sync::Arc::new(Program::parse_files(&[&program])?);
+            let p = std::sync::Arc::new(Program::parse_files_within(
+                &[&program],
+                rules_dir.as_deref(),
+            )?);
             // Parse the queries before running so a typo fails fast and writes nothing.
             let mut queries = Vec::new();
             for q in &explain {

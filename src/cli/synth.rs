@@ -143,13 +143,13 @@ pub fn run(args: SynthArgs) -> CmdResult {
     };
     let written = write_ifc(&layout, &opts)?;
     if let Some(path) = &args.truth {
-        std::fs::write(path, written.truth.to_json()).map_err(|e| {
+        super::write_atomically(path, written.truth.to_json().as_bytes()).map_err(|e| {
             Failure::bad_input(format!("cannot write truth file {}: {e}", path.display()))
         })?;
     }
     match &args.output {
         Some(path) => {
-            std::fs::write(path, &written.ifc)
+            super::write_atomically(path, written.ifc.as_bytes())
                 .map_err(|e| Failure::bad_input(format!("cannot write {}: {e}", path.display())))?;
             let c = &written.truth.counts;
             print_stdout(&format!(

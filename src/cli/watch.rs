@@ -331,15 +331,8 @@ fn changes_text(d: &ModelDiff) -> String {
     lines.join("\n")
 }
 
-/// Writes beside the file and renames it into place: readers see the old or the new file.
+/// Writes through the library's atomic writer: readers see the old or the new file.
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let fail = |e: std::io::Error| format!("{}: cannot write: {e}", path.display());
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".simulate-")
-        .tempfile_in(dir)
-        .map_err(fail)?;
-    tmp.write_all(bytes).map_err(fail)?;
-    tmp.persist(path).map_err(|e| fail(e.error))?;
-    Ok(())
+    framewright::atomic::write_atomically(path, bytes)
+        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }

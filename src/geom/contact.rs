@@ -103,6 +103,9 @@ fn aabb(b: &OrientedBox, pad: f64) -> (Point3, Point3) {
     (b.centre - r, b.centre + r)
 }
 
+/// A box covering more grid cells than this skips the grid (see `candidate_pairs`).
+const MAX_GRID_CELLS_PER_BOX: f64 = 4096.0;
+
 /// Pairs whose padded bounds share a grid cell and overlap.
 fn candidate_pairs(boxes: &[OrientedBox], pad: f64) -> Vec<(usize, usize)> {
     if boxes.len() < 2 {
@@ -115,7 +118,16 @@ fn candidate_pairs(boxes: &[OrientedBox], pad: f64) -> Vec<(usize, usize)> {
     let cell = extents[extents.len() / 2].max(0.05);
     let key = |v: f64| (v / cell).floor() as i64;
     let mut grid: FxHashMap<(i64, i64, i64), Vec<u32>> = FxHashMap::default();
+    // Boxes spanning very many cells (or non-finite ones) are compared with every box
+    // instead, so the grid's memory never grows with a piece's size or position.
+    let mut large = Vec::new();
     for (i, (lo, hi)) in bounds.iter().enumerate() {
+        let span = |k: usize| (key(hi[k]) as f64 - key(lo[k]) as f64 + 1.0).max(1.0);
+        let cells = span(0) * span(1) * span(2);
+        if cells > MAX_GRID_CELLS_PER_BOX || !cells.is_finite() {
+            large.push(i);
+            continue;
+        }
         for x in key(lo.x)..=key(hi.x) {
             for y in key(lo.y)..=key(hi.y) {
                 for z in key(lo.z)..=key(hi.z) {
@@ -136,6 +148,13 @@ fn candidate_pairs(boxes: &[OrientedBox], pad: f64) -> Vec<(usize, usize)> {
                 if overlaps(a, b) {
                     pairs.insert((a, b));
                 }
+            }
+        }
+    }
+    for &i in &large {
+        for j in 0..boxes.len() {
+            if j != i && overlaps(i.min(j), i.max(j)) {
+                pairs.insert((i.min(j), i.max(j)));
             }
         }
     }

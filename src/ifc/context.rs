@@ -2,7 +2,7 @@
 //! turn dangling references and wrong kinds into [`Issue`]s, coordinates in
 //! metres, and the warnings collected along the way.
 
-use super::error::{IfcErrorKind, Issue, R, Warning};
+use super::error::{Issue, R, Warning};
 use super::schema::Schema;
 use crate::geom::{Point3, Vector3};
 use crate::step::{Entity, Param, StepFile};
@@ -51,7 +51,9 @@ impl<'f> Ctx<'f> {
                 missing: id,
             }),
             Some(Ok(e)) => Ok(e),
-            Some(Err(step)) => Err(Issue::Fatal(IfcErrorKind::Step(step))),
+            // An unreadable instance (a `NAN` where a number belongs, say) costs the
+            // product or piece that uses it, named in a warning, not the whole model.
+            Some(Err(step)) => Err(Issue::invalid(id, format!("cannot be read: {step}"))),
         }
     }
 
@@ -158,7 +160,7 @@ impl<'f> Ctx<'f> {
             *slot = c.as_f64().unwrap_or(f64::NAN);
         }
         let v = Vector3::from(v);
-        Ok((ratios.len() >= 2 && v.iter().all(|c| c.is_finite()) && v.norm() > 1e-12).then_some(v))
+        Ok((ratios.len() >= 2 && v.norm().is_finite() && v.norm() > 1e-12).then_some(v))
     }
 
     /// A direction attribute, normalised; `None` for `$`, an empty or a zero vector

@@ -4,6 +4,7 @@
 
 use super::context::Ctx;
 use super::error::{IfcErrorKind, Issue, R, Warning};
+use super::limits::{MAX_DISTANCE_FROM_ORIGIN_M, MAX_PIECE_LENGTH_M};
 use super::placement::{Iso, Placements};
 use super::relations::{Relations, material_name};
 use super::schema::{LUMBER_PRODUCTS, display_name};
@@ -220,6 +221,7 @@ fn product_pieces(
         let built = ctx.get(placed.item, e.id).and_then(|item| {
             let solid = item_shape(ctx, &item, 0)?;
             world_box(&solid, &placement, &placed.transform, placed.item)
+                .and_then(|b| within_limits(b, placed.item))
         });
         let obox = match built {
             Ok(b) => b,
@@ -258,6 +260,39 @@ fn product_pieces(
         });
     }
     Ok(pieces)
+}
+
+/// A box that is finite, at most `MAX_PIECE_LENGTH_M` long and within
+/// `MAX_DISTANCE_FROM_ORIGIN_M` of the origin; anything else is corrupt geometry.
+fn within_limits(b: OrientedBox, item: u64) -> R<OrientedBox> {
+    let finite = b.centre.iter().all(|c| c.is_finite())
+        && b.half.iter().all(|h| h.is_finite())
+        && b.axes.iter().flat_map(|a| a.iter()).all(|c| c.is_finite());
+    if !finite {
+        return Err(Issue::degenerate(
+            item,
+            "the piece's size or position is not a finite number",
+        ));
+    }
+    let length = 2.0 * b.half[0];
+    if length > MAX_PIECE_LENGTH_M {
+        return Err(Issue::degenerate(
+            item,
+            format!(
+                "the piece is {length:.3e} m long, more than the {MAX_PIECE_LENGTH_M} m any lumber can be"
+            ),
+        ));
+    }
+    let distance = b.centre.coords.norm();
+    if distance > MAX_DISTANCE_FROM_ORIGIN_M {
+        return Err(Issue::degenerate(
+            item,
+            format!(
+                "the piece lies {distance:.3e} m from the origin, beyond {MAX_DISTANCE_FROM_ORIGIN_M} m"
+            ),
+        ));
+    }
+    Ok(b)
 }
 
 /// Explains a product without geometry; type templates are named as such.

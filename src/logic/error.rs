@@ -18,6 +18,10 @@ pub enum LogicError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// An `.input`/`.output` file name that would leave its folder (the
+    /// message names the directive, file:line and the folder).
+    #[error("{0}")]
+    Confined(String),
     /// A malformed line in a facts file.
     #[error("{file}:{line}: {message}\n  = hint: {hint}")]
     Facts {

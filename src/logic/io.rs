@@ -1,20 +1,73 @@
 //! Soufflé-compatible file I/O: `.input` reads `<rel>.facts` (tab-separated,
 //! symbols unquoted) from the facts directory, `.output` writes `<rel>.csv`
 //! (tab-separated, sorted) into the output directory; `filename=` and
-//! `delimiter=` override the defaults, absolute file names are used as they are.
+//! `delimiter=` override the defaults. A file name must stay inside its folder:
+//! no absolute path, no `..`, no symbolic link leading out (a rule file passed
+//! around must not read or write elsewhere).
 
 use super::error::LogicError;
 use super::front::ast::IoSpec;
+use super::front::confine;
 use super::interp::{Engine, Origin};
 use super::value::Value;
 use std::path::{Path, PathBuf};
 
-fn file_for(dir: &Path, rel: &str, spec: &IoSpec, ext: &str) -> PathBuf {
-    match &spec.filename {
-        Some(f) if Path::new(f).is_absolute() => PathBuf::from(f),
-        Some(f) => dir.join(f),
-        None => dir.join(format!("{rel}.{ext}")),
+/// Which directive a file belongs to, for messages.
+#[derive(Clone, Copy)]
+enum Direction {
+    Input,
+    Output,
+}
+
+impl Direction {
+    fn directive(self) -> &'static str {
+        match self {
+            Direction::Input => ".input",
+            Direction::Output => ".output",
+        }
     }
+    fn flag(self) -> &'static str {
+        match self {
+            Direction::Input => "--facts",
+            Direction::Output => "--out",
+        }
+    }
+    fn ext(self) -> &'static str {
+        match self {
+            Direction::Input => "facts",
+            Direction::Output => "csv",
+        }
+    }
+}
+
+/// The file of relation `rel` under `dir`, refused if its name leaves `dir`.
+fn file_for(
+    engine: &Engine,
+    dir: &Path,
+    rel: &str,
+    spec: &IoSpec,
+    direction: Direction,
+) -> Result<PathBuf, LogicError> {
+    let name = match &spec.filename {
+        Some(f) => f.clone(),
+        None => format!("{rel}.{}", direction.ext()),
+    };
+    let refuse = |why: String| {
+        LogicError::Confined(format!(
+            "{}: `{}` of `{rel}`: file name {name:?} {why}; it must stay in {}\n  = hint: give a \
+             plain relative name (no `..`, no absolute path, no symbolic link out), or choose the \
+             folder with {}",
+            engine.program().location(spec.span),
+            direction.directive(),
+            dir.display(),
+            direction.flag()
+        ))
+    };
+    confine::check_plain_relative(&name).map_err(refuse)?;
+    let root = confine::canonical_root(dir).map_err(refuse)?;
+    let path = dir.join(&name);
+    confine::check_inside(&root, &path).map_err(refuse)?;
+    Ok(path)
 }
 
 /// Read every `.input` relation's file from `facts_dir`.
@@ -30,7 +83,7 @@ pub fn load_inputs(engine: &mut Engine, facts_dir: &Path) -> Result<(), LogicErr
         })
         .collect();
     for (rel, spec, types) in inputs {
-        let path = file_for(facts_dir, &rel, &spec, "facts");
+        let path = file_for(engine, facts_dir, &rel, &spec, Direction::Input)?;
         let text = std::fs::read_to_string(&path).map_err(|source| LogicError::Read {
             path: path.clone(),
             source,
@@ -116,16 +169,22 @@ pub fn write_outputs(
             ));
             continue;
         }
-        let path = file_for(out_dir, &r.name, spec, "csv");
+        std::fs::create_dir_all(out_dir).map_err(|source| LogicError::Write {
+            path: out_dir.to_path_buf(),
+            source,
+        })?;
+        let path = file_for(engine, out_dir, &r.name, spec, Direction::Output)?;
         if let Some(parent) = path.parent() {
             std::fs::create_dir_all(parent).map_err(|source| LogicError::Write {
                 path: parent.to_path_buf(),
                 source,
             })?;
         }
-        std::fs::write(&path, text).map_err(|source| LogicError::Write {
-            path: path.clone(),
-            source,
+        crate::atomic::write_atomically(&path, text.as_bytes()).map_err(|source| {
+            LogicError::Write {
+                path: path.clone(),
+                source,
+            }
         })?;
         written.push(path);
     }

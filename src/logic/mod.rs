@@ -33,6 +33,16 @@ impl Program {
         front::load_files(&paths, &functors::signatures())
     }
 
+    /// Like `parse_files`, with every `.include` confined to `include_root`
+    /// instead of each file's own folder.
+    pub fn parse_files_within<P: AsRef<Path>>(
+        paths: &[P],
+        include_root: Option<&Path>,
+    ) -> Result<Program, Diagnostics> {
+        let paths: Vec<_> = paths.iter().map(|p| p.as_ref().to_path_buf()).collect();
+        front::load_files_within(&paths, include_root, &functors::signatures())
+    }
+
     /// The built-in rule base (`rules/*.dl`, embedded at build time) as one
     /// checked program; its compiled form is `compiled::program("rules")`.
     pub fn builtin() -> Result<Program, Diagnostics> {

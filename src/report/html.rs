@@ -287,7 +287,10 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
     let result = (|| {
         std::fs::create_dir(&tmp)?;
         for (file, bytes) in &files {
-            std::fs::write(tmp.join(file), bytes)?;
+            // Synced before the folder is renamed into place, so a crash cannot expose empty files.
+            let mut f = std::fs::File::create(tmp.join(file))?;
+            std::io::Write::write_all(&mut f, bytes)?;
+            f.sync_all()?;
         }
         if dir.exists() {
             // Replace only an earlier report (or an empty folder), never other files.

@@ -1,6 +1,7 @@
 //! Errors of the STEP layer. Every error carries a byte offset; the reader
 //! turns it into `line:column` so that messages point into the file.
 
+use super::source::{ENV_MAX_BYTES, ENV_MAX_DEPTH, ENV_MAX_INSTANCES, ENV_MAX_STRING_BYTES};
 use std::fmt;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -30,6 +31,15 @@ pub enum StepErrorKind {
     TooDeep { limit: usize },
     /// The file could not be read.
     Io(String),
+    /// More entity instances than the configured limit.
+    TooManyInstances { limit: usize },
+    /// A string literal longer than the configured limit.
+    StringTooLong { limit: usize },
+    /// A limit variable in the environment is not a whole number.
+    BadLimit {
+        variable: &'static str,
+        value: String,
+    },
 }
 
 /// A STEP error at a position in the file.
@@ -97,15 +107,27 @@ impl fmt::Display for StepError {
             ),
             StepErrorKind::TooLarge { bytes, limit } => write!(
                 f,
-                "the file is {bytes} bytes, over the limit of {limit} bytes; raise the limit (--max-size) if the file is genuine"
+                "the file is {bytes} bytes, over the limit of {limit} bytes; raise the limit (`inspect --max-size MB`, or {ENV_MAX_BYTES}=BYTES for every command) if the file is genuine"
             ),
             StepErrorKind::TooDeep { limit } => {
                 write!(
                     f,
-                    "lists are nested deeper than {limit} levels; the file is malformed"
+                    "lists are nested deeper than {limit} levels; the file is malformed (if it is genuine, raise the limit with {ENV_MAX_DEPTH}=N)"
                 )
             }
             StepErrorKind::Io(msg) => write!(f, "cannot read the file: {msg}"),
+            StepErrorKind::TooManyInstances { limit } => write!(
+                f,
+                "the file holds more than {limit} entity instances, the limit; raise it with {ENV_MAX_INSTANCES}=N if the file is genuine"
+            ),
+            StepErrorKind::StringTooLong { limit } => write!(
+                f,
+                "a string is longer than {limit} bytes, the limit; raise it with {ENV_MAX_STRING_BYTES}=BYTES if the file is genuine"
+            ),
+            StepErrorKind::BadLimit { variable, value } => write!(
+                f,
+                "{variable}={value:?} is not a whole number; set it to a limit such as 1000000, or unset it"
+            ),
         }
     }
 }

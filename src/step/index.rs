@@ -66,7 +66,7 @@ impl StepFile {
     }
 
     fn from_source(source: Source, options: &ReadOptions) -> Result<StepFile, StepError> {
-        let scan = Scanner::new(source.bytes(), options.max_depth).scan();
+        let scan = Scanner::new(source.bytes(), options).scan();
         let (header, raw) = match scan {
             Ok(v) => v,
             Err((offset, kind, entity)) => {
@@ -251,20 +251,24 @@ struct Scanner<'a> {
     bytes: &'a [u8],
     pos: usize,
     max_depth: usize,
+    max_instances: usize,
+    max_string_bytes: usize,
     types: FxHashMap<&'a [u8], TypeId>,
     index: RawIndex,
 }
 
 impl<'a> Scanner<'a> {
-    fn new(bytes: &'a [u8], max_depth: usize) -> Self {
+    fn new(bytes: &'a [u8], options: &ReadOptions) -> Self {
         Scanner {
             bytes,
             pos: 0,
-            max_depth,
+            max_depth: options.max_depth,
+            max_instances: options.max_instances,
+            max_string_bytes: options.max_string_bytes,
             types: FxHashMap::default(),
             // Instances take 40+ bytes in practice; reserving avoids regrowth copies.
             index: RawIndex {
-                records: Vec::with_capacity(bytes.len() / 48),
+                records: Vec::with_capacity((bytes.len() / 48).min(options.max_instances)),
                 type_names: Vec::new(),
             },
         }
@@ -489,6 +493,12 @@ impl<'a> Scanner<'a> {
                 let msg = format!("the parameter list of #{id} is not closed before `;`");
                 return Err((end, StepErrorKind::Syntax(msg), Some(id)));
             }
+            if self.index.records.len() >= self.max_instances {
+                let kind = StepErrorKind::TooManyInstances {
+                    limit: self.max_instances,
+                };
+                return Err((start, kind, Some(id)));
+            }
             self.index.records.push(Record {
                 id,
                 type_id,
@@ -536,6 +546,12 @@ impl<'a> Scanner<'a> {
             match bytes[i] {
                 b';' => return Ok(i),
                 b'\'' => match super::strings::string_end(&bytes[i + 1..]) {
+                    Some(end) if end > self.max_string_bytes => {
+                        let kind = StepErrorKind::StringTooLong {
+                            limit: self.max_string_bytes,
+                        };
+                        return Err((i, kind, entity.map(|(id, _)| id)));
+                    }
                     Some(end) => at = i + 1 + end + 1,
                     None => return Err(truncated()),
                 },

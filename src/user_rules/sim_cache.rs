@@ -219,10 +219,7 @@ fn write_entry(file: &Path, key: &str, facts: &Facts) -> std::io::Result<()> {
     if let Some(dir) = file.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    // Written beside and renamed, so a reader never sees half a file.
-    let tmp = file.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&tmp, text)?;
-    std::fs::rename(&tmp, file)
+    crate::atomic::write_atomically(file, text.as_bytes())
 }
 
 #[cfg(test)]

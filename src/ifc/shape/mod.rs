@@ -84,8 +84,25 @@ pub(crate) fn body_items(ctx: &Ctx<'_>, product: &Entity<'_>) -> R<Option<Vec<Pl
         return Ok(Some(Vec::new()));
     };
     let mut out = Vec::new();
-    for item in ctx.refs(&rep, 3)? {
-        expand(ctx, item, rep.id, Affine::identity(), 0, &mut out)?;
+    let items = ctx.refs(&rep, 3)?;
+    let many = items.len() > 1;
+    for item in items {
+        match expand(ctx, item, rep.id, Affine::identity(), 0, &mut out) {
+            Ok(()) => {}
+            // One bad item of several (an absurd mapping, say) costs that piece only.
+            Err(issue @ (Issue::Invalid { .. } | Issue::Degenerate { .. })) if many => {
+                ctx.warn(
+                    Some(product.id),
+                    format!(
+                        "#{item}, a body item of #{} (line {}), skipped: {}",
+                        product.id,
+                        ctx.line(product.id),
+                        issue.describe()
+                    ),
+                );
+            }
+            Err(issue) => return Err(issue),
+        }
     }
     Ok(Some(out))
 }

@@ -3,6 +3,7 @@
 
 use super::super::context::Ctx;
 use super::super::error::{Issue, R};
+use super::super::limits::MAX_OPERATOR_SCALE;
 use super::super::placement::frame;
 use crate::geom::{Affine, Point3, Vector3};
 use crate::step::Entity;
@@ -46,6 +47,14 @@ pub(crate) fn transformation(ctx: &Ctx<'_>, e: &Entity<'_>) -> R<Affine> {
             return Err(Issue::degenerate(
                 e.id,
                 format!("scale factor {s} is not positive"),
+            ));
+        }
+        if s > MAX_OPERATOR_SCALE {
+            return Err(Issue::degenerate(
+                e.id,
+                format!(
+                    "scale factor {s:e} is absurd (above {MAX_OPERATOR_SCALE}); the file is probably corrupt"
+                ),
             ));
         }
     }

@@ -8,6 +8,7 @@
 pub mod ast;
 pub mod check;
 pub mod codegen;
+pub mod confine;
 pub mod diag;
 pub mod lex;
 pub mod parse;
@@ -19,7 +20,18 @@ use std::path::{Path, PathBuf};
 
 /// Parse and check the given files (and what they `.include`) as one program.
 pub fn load_files(paths: &[PathBuf], functors: &[FunctorSig]) -> Result<Program, Diagnostics> {
+    load_files_within(paths, None, functors)
+}
+
+/// Like `load_files`, with `.include`s confined to `include_root` instead of
+/// each top-level file's own folder (`--rules-dir`).
+pub fn load_files_within(
+    paths: &[PathBuf],
+    include_root: Option<&Path>,
+    functors: &[FunctorSig],
+) -> Result<Program, Diagnostics> {
     let mut loader = check::Loader::new(functors);
+    loader.set_include_root(include_root);
     for p in paths {
         loader.load_file(p, None)?;
     }
