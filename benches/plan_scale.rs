@@ -40,8 +40,11 @@ fn plan(path: &Path, options: &SearchOptions, label: &str) -> (f64, Vec<u8>) {
     let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");
     lap("rule base");
     if std::env::var_os("PLAN_SCALE_SIZES").is_some() {
-        let mut sizes: Vec<(usize, &String)> =
-            reasoned.relations.iter().map(|(n, t)| (t.len(), n)).collect();
+        let mut sizes: Vec<(usize, &String)> = reasoned
+            .relations
+            .iter()
+            .map(|(n, t)| (t.len(), n))
+            .collect();
         sizes.sort();
         for (n, name) in sizes.iter().rev().take(15) {
             eprintln!("    {name} {n}");

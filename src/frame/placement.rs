@@ -85,8 +85,9 @@ pub fn candidate_offsets(min: f64, max: f64) -> Vec<f64> {
         .collect()
 }
 
-/// `placement_candidate(w, x)` for every wall and offset, `placement_reaches(p, x)` for every
-/// piece the arm reaches with its wall at x.
+/// `placement_candidate(w, x)` for every wall and offset, `placement_reaches(p, from, to)` for
+/// every run of offsets at which the arm reaches a piece, `placement_nail_reaches(…, from, to)`
+/// the same for nails.
 pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Facts {
     placement_facts_with(cell, first, min, max, &SearchOptions::default())
 }
@@ -180,26 +181,26 @@ pub fn placement_facts_with(
             );
         }
     }
-    for ((p, _, _), xs) in pieces.iter().zip(&reached) {
-        for &x in xs {
+    for ((p, _, _), runs) in pieces.iter().zip(&reached) {
+        for &(from, to) in runs {
             facts.add(
                 "placement_reaches",
-                vec![Value::sym(p), Value::float(x)],
+                vec![Value::sym(p), Value::float(from), Value::float(to)],
                 Origin::Event(format!(
-                    "placement search: IK solves the place pose of {p} and the pose above it with its wall at x = {x:.3} m"
+                    "placement search: IK solves the place pose of {p} and the pose above it with its wall at every x from {from:.3} to {to:.3} m"
                 )),
             );
         }
     }
-    for ((key, _, _), xs) in nails.iter().zip(&nails_reached) {
-        for &x in xs {
+    for ((key, _, _), runs) in nails.iter().zip(&nails_reached) {
+        for &(from, to) in runs {
             let mut tuple = key.clone();
-            tuple.push(Value::float(x));
+            tuple.extend([Value::float(from), Value::float(to)]);
             facts.add(
                 "placement_nail_reaches",
                 tuple,
                 Origin::Event(format!(
-                    "placement search: IK solves the nailer's pose and its approach for a nail of {} into {} with the wall at x = {x:.3} m",
+                    "placement search: IK solves the nailer's pose and its approach for a nail of {} into {} with the wall at every x from {from:.3} to {to:.3} m",
                     key[0], key[1]
                 )),
             );
@@ -214,11 +215,11 @@ fn search_each<T: Sync>(
     items: &[T],
     key: impl Fn(&T) -> [i64; 10],
     share: bool,
-    search: impl Fn(&T) -> Vec<f64> + Sync,
-) -> Vec<Vec<f64>> {
+    search: impl Fn(&T) -> Vec<(f64, f64)> + Sync,
+) -> Vec<Vec<(f64, f64)>> {
     use rayon::prelude::*;
     if !share {
-        return items.par_iter().map(|item| search(item)).collect();
+        return items.par_iter().map(&search).collect();
     }
     let mut first_of: rustc_hash::FxHashMap<[i64; 10], usize> = Default::default();
     let mut unique: Vec<&T> = Vec::new();
@@ -231,7 +232,7 @@ fn search_each<T: Sync>(
             })
         })
         .collect();
-    let found: Vec<Vec<f64>> = unique.par_iter().map(|item| search(item)).collect();
+    let found: Vec<Vec<(f64, f64)>> = unique.par_iter().map(|item| search(item)).collect();
     slot.into_iter().map(|k| found[k].clone()).collect()
 }
 
@@ -244,7 +245,10 @@ fn grid(v: &Vector3<f64>) -> [i64; 3] {
 fn pose_key(pose: &Isometry3<f64>, size: &[f64; 3]) -> [i64; 10] {
     let mut q = pose.rotation.into_inner().coords;
     // q and -q are one rotation.
-    if q.iter().find(|c| c.abs() > 0.5 * SHARE_GRID).is_some_and(|c| *c < 0.0) {
+    if q.iter()
+        .find(|c| c.abs() > 0.5 * SHARE_GRID)
+        .is_some_and(|c| *c < 0.0)
+    {
         q = -q;
     }
     let mut key = [0; 10];
@@ -255,17 +259,27 @@ fn pose_key(pose: &Isometry3<f64>, size: &[f64; 3]) -> [i64; 10] {
     key
 }
 
-/// The offsets at which something is reached with ROBUST_STEPS offsets to spare on both sides:
-/// a piece held a little off its planned grip, or a wall a little off its place, still works.
-fn robustly(offsets: &[f64], ok: &[bool]) -> Vec<f64> {
-    (0..offsets.len())
-        .filter(|&i| {
-            let lo = i.saturating_sub(ROBUST_STEPS);
-            let hi = (i + ROBUST_STEPS).min(ok.len() - 1);
-            ok[lo..=hi].iter().all(|b| *b)
-        })
-        .map(|i| offsets[i])
-        .collect()
+/// The runs of consecutive offsets (first, last) at which something is reached with
+/// ROBUST_STEPS offsets to spare on both sides: a piece held a little off its planned grip, or
+/// a wall a little off its place, still works. One fact per run keeps the facts few.
+fn robustly(offsets: &[f64], ok: &[bool]) -> Vec<(f64, f64)> {
+    let robust = |i: usize| {
+        let lo = i.saturating_sub(ROBUST_STEPS);
+        let hi = (i + ROBUST_STEPS).min(ok.len() - 1);
+        ok[lo..=hi].iter().all(|b| *b)
+    };
+    let mut runs: Vec<(f64, f64)> = Vec::new();
+    let mut previous = false;
+    for (i, &x) in offsets.iter().enumerate() {
+        let now = robust(i);
+        match runs.last_mut() {
+            Some(run) if now && previous => run.1 = x,
+            _ if now => runs.push((x, x)),
+            _ => {}
+        }
+        previous = now;
+    }
+    runs
 }
 
 /// A robot-frame pose moved `x` along the robot's +x.
@@ -318,6 +332,19 @@ fn solves_above_floor(cell: &Cell, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reached_offsets_come_as_robust_runs() {
+        let offsets: Vec<f64> = (0..12).map(|k| k as f64).collect();
+        // Reached everywhere but 7: robust (two reached steps each side, or the end of the
+        // range) at 0..=4 and 10..=11.
+        let ok: Vec<bool> = (0..12).map(|k| k != 7).collect();
+        assert_eq!(robustly(&offsets, &ok), vec![(0.0, 4.0), (10.0, 11.0)]);
+        let all = vec![true; 12];
+        assert_eq!(robustly(&offsets, &all), vec![(0.0, 11.0)]);
+        let none = vec![false; 12];
+        assert!(robustly(&offsets, &none).is_empty());
+    }
 
     #[test]
     fn offsets_cover_the_range_in_whole_millimetres() {
