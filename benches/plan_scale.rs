@@ -6,7 +6,8 @@
 //! per storey and no search cache (the path before per-wall reasoning), and the ratio.
 //!
 //! `cargo bench --bench plan_scale` (`-- --storeys 1` for a quick run; `-- --skip-old` to
-//! time only the current path). Peak memory: `/usr/bin/time -v framewright plan --json M.ifc`.
+//! time only the current path; `PLAN_SCALE_SIZES=1` also prints the largest relations).
+//! Peak memory: `/usr/bin/time -v framewright plan --json M.ifc`.
 
 use framewright::cell::Cell;
 use framewright::frame::placement::{SearchOptions, add_placement_facts_with};
