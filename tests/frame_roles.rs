@@ -171,7 +171,7 @@ fn blocking_and_doubled_studs() {
         openings: vec![],
     };
     let mut layout = single_wall("blocking", "blocking and a doubled stud", &spec).unwrap();
-    let wall = &mut layout.buildings[0].walls[0];
+    let wall = &mut layout.buildings[0].storeys[0].walls[0];
     let (t, depth) = (Lumber::L2X4.thickness, Lumber::L2X4.width);
     let mut studs: Vec<WallBox> = wall
         .pieces

@@ -26,7 +26,7 @@ fn count(layout: &Layout, role: Role) -> usize {
 fn tm1_is_a_square_frame_with_39in_plates_and_36in_studs() {
     let l = models::tm1();
     assert_eq!(l.piece_count(), 4);
-    let w = &l.buildings[0].walls[0];
+    let w = &l.buildings[0].storeys[0].walls[0];
     let lengths: Vec<f64> = w.pieces.iter().map(|p| p.length() / inches(1.0)).collect();
     for (got, want) in lengths.iter().zip([39.0, 36.0, 36.0, 39.0]) {
         assert!((got - want).abs() < 1e-9, "{lengths:?}");
@@ -46,7 +46,7 @@ fn tm1_is_a_square_frame_with_39in_plates_and_36in_studs() {
 
 #[test]
 fn tm2_is_a_2x6_frame_6ft_long_5ft_high() {
-    let w = models::tm2().buildings[0].walls[0].clone();
+    let w = models::tm2().buildings[0].storeys[0].walls[0].clone();
     assert!((w.length - feet(6.0)).abs() < EPS && (w.height - feet(5.0)).abs() < EPS);
     assert!((w.thickness - inches(5.5)).abs() < EPS);
     assert_eq!(w.pieces.len(), 4);
@@ -361,7 +361,7 @@ fn window_is_framed_with_king_jack_header_sill_and_cripples() {
         (2, 2, 2, 1)
     );
     assert_eq!(roles(Role::CrippleStud), 4);
-    let w = &l.buildings[0].walls[0];
+    let w = &l.buildings[0].storeys[0].walls[0];
     let jack = w.pieces.iter().find(|p| p.role == Role::JackStud).unwrap();
     let header = w.pieces.iter().find(|p| p.role == Role::Header).unwrap();
     assert!(
@@ -391,7 +391,7 @@ fn door_cuts_the_bottom_plate() {
         &twelve_foot_wall(vec![models::door_at(inches(53.0))], HeaderStyle::BuiltUp),
     )
     .unwrap();
-    let bottoms: Vec<_> = l.buildings[0].walls[0]
+    let bottoms: Vec<_> = l.buildings[0].storeys[0].walls[0]
         .pieces
         .iter()
         .filter(|p| p.role == Role::BottomPlate)

@@ -32,6 +32,26 @@ const NOSE_GAP: f64 = 0.002;
 /// The arm and its tool keep at least this far above the floor (m).
 const FLOOR_CLEARANCE: f64 = 0.002;
 
+/// How the placement search runs.
+#[derive(Debug, Clone, Copy)]
+pub struct SearchOptions {
+    /// Targets whose poses agree to SHARE_GRID run the search once (repeated walls of a
+    /// big model are searched once); off, every target runs its own search.
+    pub share_equal_poses: bool,
+}
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        SearchOptions {
+            share_equal_poses: true,
+        }
+    }
+}
+
+/// Poses whose coordinates (m), unit-quaternion components and sizes (m) round to the same
+/// multiple of this share one search: 1 nm, far below the 1 cm step of the offsets.
+pub const SHARE_GRID: f64 = 1e-9;
+
 /// Adds the placement facts when the cell places walls automatically (a first pass of the
 /// rules gives the pieces' poses with every wall at offset 0). Nothing to add otherwise.
 pub fn add_placement_facts(
@@ -39,11 +59,21 @@ pub fn add_placement_facts(
     cell: &Cell,
     engine: &RuleEngine,
 ) -> Result<(), FrameError> {
+    add_placement_facts_with(facts, cell, engine, &SearchOptions::default())
+}
+
+/// `add_placement_facts` with search options.
+pub fn add_placement_facts_with(
+    facts: &mut Facts,
+    cell: &Cell,
+    engine: &RuleEngine,
+    options: &SearchOptions,
+) -> Result<(), FrameError> {
     let OffsetX::Auto { min, max } = cell.assembly.offset_x else {
         return Ok(());
     };
     let first = reason(facts, engine, false)?;
-    facts.extend(placement_facts(cell, &first, min, max));
+    facts.extend(placement_facts_with(cell, &first, min, max, options));
     Ok(())
 }
 
@@ -55,10 +85,21 @@ pub fn candidate_offsets(min: f64, max: f64) -> Vec<f64> {
         .collect()
 }
 
-/// `placement_candidate(w, x)` for every wall and offset, `placement_reaches(p, x)` for every
-/// piece the arm reaches with its wall at x.
+/// `placement_candidate(w, x)` for every wall and offset, `placement_reaches(p, from, to)` for
+/// every run of offsets at which the arm reaches a piece, `placement_nail_reaches(…, from, to)`
+/// the same for nails.
 pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Facts {
-    use rayon::prelude::*;
+    placement_facts_with(cell, first, min, max, &SearchOptions::default())
+}
+
+/// `placement_facts` with search options.
+pub fn placement_facts_with(
+    cell: &Cell,
+    first: &Reasoned,
+    min: f64,
+    max: f64,
+    options: &SearchOptions,
+) -> Facts {
     let offsets = candidate_offsets(min, max);
     let sizes: BTreeMap<&str, [f64; 3]> = first
         .get("piece_size")
@@ -85,16 +126,19 @@ pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Fac
             Some((p, pose.0, *sizes.get(p)?))
         })
         .collect();
-    let reached: Vec<Vec<f64>> = pieces
-        .par_iter()
-        .map(|(_, at_zero, size)| {
+    let share = options.share_equal_poses;
+    let reached = search_each(
+        &pieces,
+        |(_, pose, size)| pose_key(pose, size),
+        share,
+        |(_, at_zero, size)| {
             let ok: Vec<bool> = offsets
                 .iter()
                 .map(|x| reaches(cell, &shifted(at_zero, *x), size))
                 .collect();
             robustly(&offsets, &ok)
-        })
-        .collect();
+        },
+    );
     let nails: Vec<(Vec<Value>, Point3<f64>, Vector3<f64>)> = first
         .get("placement_nail_at_zero")
         .iter()
@@ -106,16 +150,23 @@ pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Fac
             Some((t[..5].to_vec(), Point3::from(point.0), direction.0))
         })
         .collect();
-    let nails_reached: Vec<Vec<f64>> = nails
-        .par_iter()
-        .map(|(_, point, direction)| {
+    let nails_reached = search_each(
+        &nails,
+        |(_, point, direction)| {
+            let mut key = [0; 10];
+            key[..3].copy_from_slice(&grid(&point.coords));
+            key[3..6].copy_from_slice(&grid(direction));
+            key
+        },
+        share,
+        |(_, point, direction)| {
             let ok: Vec<bool> = offsets
                 .iter()
                 .map(|x| nail_reached(cell, &(point + Vector3::new(*x, 0.0, 0.0)), direction))
                 .collect();
             robustly(&offsets, &ok)
-        })
-        .collect();
+        },
+    );
 
     let mut facts = Facts::default();
     let mut wall_names: Vec<&str> = walls.values().copied().collect();
@@ -130,26 +181,26 @@ pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Fac
             );
         }
     }
-    for ((p, _, _), xs) in pieces.iter().zip(&reached) {
-        for &x in xs {
+    for ((p, _, _), runs) in pieces.iter().zip(&reached) {
+        for &(from, to) in runs {
             facts.add(
                 "placement_reaches",
-                vec![Value::sym(p), Value::float(x)],
+                vec![Value::sym(p), Value::float(from), Value::float(to)],
                 Origin::Event(format!(
-                    "placement search: IK solves the place pose of {p} and the pose above it with its wall at x = {x:.3} m"
+                    "placement search: IK solves the place pose of {p} and the pose above it with its wall at every x from {from:.3} to {to:.3} m"
                 )),
             );
         }
     }
-    for ((key, _, _), xs) in nails.iter().zip(&nails_reached) {
-        for &x in xs {
+    for ((key, _, _), runs) in nails.iter().zip(&nails_reached) {
+        for &(from, to) in runs {
             let mut tuple = key.clone();
-            tuple.push(Value::float(x));
+            tuple.extend([Value::float(from), Value::float(to)]);
             facts.add(
                 "placement_nail_reaches",
                 tuple,
                 Origin::Event(format!(
-                    "placement search: IK solves the nailer's pose and its approach for a nail of {} into {} with the wall at x = {x:.3} m",
+                    "placement search: IK solves the nailer's pose and its approach for a nail of {} into {} with the wall at every x from {from:.3} to {to:.3} m",
                     key[0], key[1]
                 )),
             );
@@ -158,17 +209,77 @@ pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Fac
     facts
 }
 
-/// The offsets at which something is reached with ROBUST_STEPS offsets to spare on both sides:
-/// a piece held a little off its planned grip, or a wall a little off its place, still works.
-fn robustly(offsets: &[f64], ok: &[bool]) -> Vec<f64> {
-    (0..offsets.len())
-        .filter(|&i| {
-            let lo = i.saturating_sub(ROBUST_STEPS);
-            let hi = (i + ROBUST_STEPS).min(ok.len() - 1);
-            ok[lo..=hi].iter().all(|b| *b)
+/// `search` for every item, in parallel; with `share`, items of one key run it once (the
+/// first of them in order stands for the rest, so the result is deterministic).
+fn search_each<T: Sync>(
+    items: &[T],
+    key: impl Fn(&T) -> [i64; 10],
+    share: bool,
+    search: impl Fn(&T) -> Vec<(f64, f64)> + Sync,
+) -> Vec<Vec<(f64, f64)>> {
+    use rayon::prelude::*;
+    if !share {
+        return items.par_iter().map(&search).collect();
+    }
+    let mut first_of: rustc_hash::FxHashMap<[i64; 10], usize> = Default::default();
+    let mut unique: Vec<&T> = Vec::new();
+    let slot: Vec<usize> = items
+        .iter()
+        .map(|item| {
+            *first_of.entry(key(item)).or_insert_with(|| {
+                unique.push(item);
+                unique.len() - 1
+            })
         })
-        .map(|i| offsets[i])
-        .collect()
+        .collect();
+    let found: Vec<Vec<(f64, f64)>> = unique.par_iter().map(|item| search(item)).collect();
+    slot.into_iter().map(|k| found[k].clone()).collect()
+}
+
+/// Coordinates in whole SHARE_GRID steps.
+fn grid(v: &Vector3<f64>) -> [i64; 3] {
+    v.map(|c| (c / SHARE_GRID).round() as i64).into()
+}
+
+/// The search key of a piece: its pose at offset 0 and its size, on the SHARE_GRID.
+fn pose_key(pose: &Isometry3<f64>, size: &[f64; 3]) -> [i64; 10] {
+    let mut q = pose.rotation.into_inner().coords;
+    // q and -q are one rotation.
+    if q.iter()
+        .find(|c| c.abs() > 0.5 * SHARE_GRID)
+        .is_some_and(|c| *c < 0.0)
+    {
+        q = -q;
+    }
+    let mut key = [0; 10];
+    key[..3].copy_from_slice(&grid(&pose.translation.vector));
+    key[3..6].copy_from_slice(&grid(&q.xyz()));
+    key[6] = (q.w / SHARE_GRID).round() as i64;
+    key[7..].copy_from_slice(&grid(&Vector3::from(*size)));
+    key
+}
+
+/// The runs of consecutive offsets (first, last) at which something is reached with
+/// ROBUST_STEPS offsets to spare on both sides: a piece held a little off its planned grip, or
+/// a wall a little off its place, still works. One fact per run keeps the facts few.
+fn robustly(offsets: &[f64], ok: &[bool]) -> Vec<(f64, f64)> {
+    let robust = |i: usize| {
+        let lo = i.saturating_sub(ROBUST_STEPS);
+        let hi = (i + ROBUST_STEPS).min(ok.len() - 1);
+        ok[lo..=hi].iter().all(|b| *b)
+    };
+    let mut runs: Vec<(f64, f64)> = Vec::new();
+    let mut previous = false;
+    for (i, &x) in offsets.iter().enumerate() {
+        let now = robust(i);
+        match runs.last_mut() {
+            Some(run) if now && previous => run.1 = x,
+            _ if now => runs.push((x, x)),
+            _ => {}
+        }
+        previous = now;
+    }
+    runs
 }
 
 /// A robot-frame pose moved `x` along the robot's +x.
@@ -221,6 +332,19 @@ fn solves_above_floor(cell: &Cell, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reached_offsets_come_as_robust_runs() {
+        let offsets: Vec<f64> = (0..12).map(|k| k as f64).collect();
+        // Reached everywhere but 7: robust (two reached steps each side, or the end of the
+        // range) at 0..=4 and 10..=11.
+        let ok: Vec<bool> = (0..12).map(|k| k != 7).collect();
+        assert_eq!(robustly(&offsets, &ok), vec![(0.0, 4.0), (10.0, 11.0)]);
+        let all = vec![true; 12];
+        assert_eq!(robustly(&offsets, &all), vec![(0.0, 11.0)]);
+        let none = vec![false; 12];
+        assert!(robustly(&offsets, &none).is_empty());
+    }
 
     #[test]
     fn offsets_cover_the_range_in_whole_millimetres() {

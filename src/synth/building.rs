@@ -1,6 +1,6 @@
 //! Rectangular buildings of four walls, and grids of them for big models.
 use crate::synth::SynthError;
-use crate::synth::layout::{BuildingLayout, Layout, Vec3, WallFrame};
+use crate::synth::layout::{BuildingLayout, Layout, StoreyLayout, Vec3, WallFrame, WallLayout};
 use crate::synth::units::Lumber;
 use crate::synth::wall::{HeaderStyle, OpeningSpec, StudLayout, WallSpec, frame_wall};
 
@@ -36,6 +36,19 @@ pub fn frame_building(
     origin: Vec3,
     prefix: &str,
 ) -> Result<BuildingLayout, SynthError> {
+    Ok(BuildingLayout::one_storey(
+        name,
+        origin,
+        frame_unit(spec, origin, prefix)?,
+    ))
+}
+
+/// The four walls of one rectangular unit whose outer front-left corner sits at `origin`.
+fn frame_unit(
+    spec: &BuildingSpec,
+    origin: Vec3,
+    prefix: &str,
+) -> Result<Vec<WallLayout>, SynthError> {
     let t = spec.lumber.width;
     if !(spec.depth.is_finite() && spec.depth > 2.0 * t) {
         return Err(SynthError::Building {
@@ -71,12 +84,7 @@ pub fn frame_building(
         };
         walls.push(frame_wall(&wall, frame)?);
     }
-    Ok(BuildingLayout {
-        name: name.to_string(),
-        origin,
-        storey_name: "Level 1".into(),
-        walls,
-    })
+    Ok(walls)
 }
 
 /// `rows` x `cols` copies of the building, `gap` metres apart, each its own IfcBuilding.
@@ -116,6 +124,98 @@ pub fn grid(
         description: format!(
             "{rows}x{cols} grid of {} m x {} m wood-frame buildings",
             spec.length, spec.depth
+        ),
+        buildings,
+    })
+}
+
+/// Multi-storey blocks: `blocks` IfcBuildings in a row along x, each with `storeys`
+/// storeys, each storey holding `rows` x `cols` units of the building spec `gap` metres
+/// apart. Storeys stack `floor_depth` above the walls below (the floor structure), so
+/// walls of different storeys never touch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockSpec {
+    pub unit: BuildingSpec,
+    pub blocks: usize,
+    pub storeys: usize,
+    pub rows: usize,
+    pub cols: usize,
+    pub gap: f64,
+    pub floor_depth: f64,
+}
+
+/// Refuse block models with more than this many storeys in all (about 10^6 members at 10,000 units).
+pub const MAX_STOREYS: usize = 1_000;
+
+/// The layout of `spec`'s blocks; wall ids read `K<block>-L<storey>-U<row>_<col>-<side>`.
+pub fn blocks(spec: &BlockSpec, name: &str) -> Result<Layout, SynthError> {
+    let units = spec.rows.saturating_mul(spec.cols);
+    let storeys = spec.blocks.saturating_mul(spec.storeys);
+    if units == 0
+        || storeys == 0
+        || storeys > MAX_STOREYS
+        || units.saturating_mul(storeys) > MAX_BUILDINGS
+    {
+        return Err(SynthError::Building {
+            what: format!(
+                "{} blocks x {} storeys x {}x{} units is empty or too big",
+                spec.blocks, spec.storeys, spec.rows, spec.cols
+            ),
+            hint: format!(
+                "use at least one of each, at most {MAX_STOREYS} storeys and {MAX_BUILDINGS} units in all"
+            ),
+        });
+    }
+    if !(spec.gap.is_finite()
+        && spec.gap >= 0.0
+        && spec.floor_depth.is_finite()
+        && spec.floor_depth > 0.0)
+    {
+        return Err(SynthError::Building {
+            what: format!("gap {} m, floor depth {} m", spec.gap, spec.floor_depth),
+            hint: "the gap must be zero or positive and the floor depth positive".into(),
+        });
+    }
+    let u = &spec.unit;
+    let block_length = spec.cols as f64 * (u.length + spec.gap);
+    let storey_height = u.height + spec.floor_depth;
+    let mut buildings = Vec::with_capacity(spec.blocks);
+    for k in 0..spec.blocks {
+        let block = format!("K{}", k + 1);
+        let origin = Vec3::new(k as f64 * (block_length + spec.gap), 0.0, 0.0);
+        let mut levels = Vec::with_capacity(spec.storeys);
+        for s in 0..spec.storeys {
+            let elevation = s as f64 * storey_height;
+            let mut walls = Vec::with_capacity(4 * units);
+            for r in 0..spec.rows {
+                for c in 0..spec.cols {
+                    let corner = origin
+                        + Vec3::new(
+                            c as f64 * (u.length + spec.gap),
+                            r as f64 * (u.depth + spec.gap),
+                            elevation,
+                        );
+                    let prefix = format!("{block}-L{}-U{}_{}-", s + 1, r + 1, c + 1);
+                    walls.extend(frame_unit(u, corner, &prefix)?);
+                }
+            }
+            levels.push(StoreyLayout {
+                name: format!("Level {}", s + 1),
+                elevation,
+                walls,
+            });
+        }
+        buildings.push(BuildingLayout {
+            name: block,
+            origin,
+            storeys: levels,
+        });
+    }
+    Ok(Layout {
+        name: name.to_string(),
+        description: format!(
+            "{} blocks of {} storeys, {}x{} units of {} m x {} m per storey",
+            spec.blocks, spec.storeys, spec.rows, spec.cols, u.length, u.depth
         ),
         buildings,
     })

@@ -6,7 +6,7 @@
 //! seeded hash of stable keys, timestamps are fixed, caches are BTreeMaps.
 use crate::synth::SynthError;
 use crate::synth::guid;
-use crate::synth::layout::{BuildingLayout, Layout, Piece, Vec3, WallLayout};
+use crate::synth::layout::{BuildingLayout, Layout, Piece, StoreyLayout, Vec3, WallLayout};
 use crate::synth::step_text::{Real, RealList, Ref, RefList, StepWriter, string};
 use crate::synth::targets::{self, Nail};
 use crate::synth::truth::{
@@ -90,6 +90,10 @@ pub struct WriteOptions {
     /// `None`: relative to the parent when grouped, else to the storey.
     pub placement: Option<PlacementBase>,
     pub seed: u64,
+    /// A property set (`Pset_MemberCommon`, …) for every framing product.
+    pub property_sets: bool,
+    /// For grouped walls: an IfcOpeningElement and an IfcDoor or IfcWindow per rough opening.
+    pub openings: bool,
     /// The file name written into FILE_NAME and the truth file (no directories).
     pub file_name: String,
 }
@@ -104,6 +108,8 @@ impl Default for WriteOptions {
             mapped: false,
             placement: None,
             seed: 20_240_101,
+            property_sets: false,
+            openings: false,
             file_name: "model.ifc".into(),
         }
     }
@@ -263,6 +269,40 @@ impl Ctx<'_> {
         );
         self.profiles.insert(key, r);
         r
+    }
+
+    /// A box from the placement's origin to `size` (metres): its x by y rectangle extruded along z.
+    fn box_body(&mut self, size: Vec3) -> Ref {
+        let centre = self.point2d(size[0] / 2.0, size[1] / 2.0);
+        let profile_pos = self
+            .w
+            .add("IFCAXIS2PLACEMENT2D", format_args!("{centre},$"));
+        let s = self.scale;
+        let profile = self.w.add(
+            "IFCRECTANGLEPROFILEDEF",
+            format_args!(
+                ".AREA.,$,{profile_pos},{},{}",
+                Real(size[0] * s),
+                Real(size[1] * s)
+            ),
+        );
+        let z = self.dir(Vec3::z());
+        let solid = self.w.add(
+            "IFCEXTRUDEDAREASOLID",
+            format_args!("{profile},{},{z},{}", self.identity, Real(size[2] * s)),
+        );
+        let rep = self.w.add(
+            "IFCSHAPEREPRESENTATION",
+            format_args!("{},'Body','SweptSolid',({solid})", self.body),
+        );
+        self.w
+            .add("IFCPRODUCTDEFINITIONSHAPE", format_args!("$,$,({rep})"))
+    }
+
+    /// A 2D point given in metres.
+    fn point2d(&mut self, x: f64, y: f64) -> Ref {
+        let s = self.scale;
+        self.w.add("IFCCARTESIANPOINT", RealList(&[x * s, y * s]))
     }
 
     /// A representation map of a section extruded one file unit along z.
@@ -455,7 +495,7 @@ fn write_units(w: &mut StepWriter, unit: LengthUnit) -> Ref {
     )
 }
 
-/// Building, storey, walls and their relationships; returns the IfcBuilding.
+/// Building, storeys, walls and their relationships; returns the IfcBuilding.
 fn write_building(
     ctx: &mut Ctx,
     b: &BuildingLayout,
@@ -465,7 +505,6 @@ fn write_building(
     members: &mut Vec<TruthMember>,
     walls: &mut Vec<TruthWall>,
 ) -> Result<Ref, SynthError> {
-    let opts = ctx.opts;
     let a2p = ctx.placement3d(b.origin, Vec3::z(), Vec3::x());
     let b_lp = ctx.local_placement(Some(site_lp), a2p);
     let args = format!(
@@ -474,60 +513,27 @@ fn write_building(
         string(&b.name)
     );
     let building = ctx.w.add("IFCBUILDING", args);
-    let s_lp = ctx.local_placement(Some(b_lp), ctx.identity);
-    let args = format!(
-        "{},{},$,$,{s_lp},$,$,.ELEMENT.,0.",
-        ctx.owner_args(&format!("storey:{}", b.name)),
-        string(&b.storey_name)
-    );
-    let storey = ctx.w.add("IFCBUILDINGSTOREY", args);
-
-    let mut contained = Vec::new();
+    let mut storeys = Vec::with_capacity(b.storeys.len());
     let mut framing = Vec::new();
-    for wall in &b.walls {
-        let parent = write_parent(ctx, b, wall, s_lp);
-        let (parent_ref, parent_lp, parent_gid) = match parent {
-            Some((r, lp, gid)) => (Some(r), Some(lp), Some(gid)),
-            None => (None, None, None),
-        };
-        let place = WallPlacement {
-            wall,
-            building_origin: b.origin,
-            storey_lp: s_lp,
-            parent_lp,
-            base,
-        };
-        let products = if opts.mapped {
-            write_mapped_wall(ctx, &place, b, parent_gid.clone(), members)
+    for (k, s) in b.storeys.iter().enumerate() {
+        // The first storey keeps the keys one-storey buildings always had.
+        let key = if k == 0 {
+            b.name.clone()
         } else {
-            write_piece_products(ctx, &place, b, parent_gid.clone(), members)
+            format!("{}:{}", b.name, s.name)
         };
-        let first = members.len() - wall.pieces.len();
-        walls.push(truth_wall(
-            wall,
+        storeys.push(write_storey(
+            ctx,
             b,
-            parent_gid,
-            opts.grouping,
-            &members[first..],
+            s,
+            &key,
+            b_lp,
+            base,
+            members,
+            walls,
+            &mut framing,
         ));
-        match parent_ref {
-            Some(p) => {
-                let rel = ctx.owner_args(&format!("rel:wall:{}", wall.id));
-                ctx.w.add(
-                    "IFCRELAGGREGATES",
-                    format_args!("{rel},$,$,{p},{}", RefList(&products)),
-                );
-                contained.push(p);
-            }
-            None => contained.extend_from_slice(&products),
-        }
-        framing.extend(products);
     }
-    let rel = ctx.owner_args(&format!("rel:contain:{}", b.name));
-    ctx.w.add(
-        "IFCRELCONTAINEDINSPATIALSTRUCTURE",
-        format_args!("{rel},$,$,{},{storey}", RefList(&contained)),
-    );
     let rel = ctx.owner_args(&format!("rel:material:{}", b.name));
     ctx.w.add(
         "IFCRELASSOCIATESMATERIAL",
@@ -536,16 +542,211 @@ fn write_building(
     let rel = ctx.owner_args(&format!("rel:building:{}", b.name));
     ctx.w.add(
         "IFCRELAGGREGATES",
-        format_args!("{rel},$,$,{building},({storey})"),
+        format_args!("{rel},$,$,{building},{}", RefList(&storeys)),
     );
     Ok(building)
+}
+
+/// One storey with its walls; `framing` collects the framing products. Returns the storey.
+#[allow(clippy::too_many_arguments)]
+fn write_storey(
+    ctx: &mut Ctx,
+    b: &BuildingLayout,
+    s: &StoreyLayout,
+    key: &str,
+    building_lp: Ref,
+    base: PlacementBase,
+    members: &mut Vec<TruthMember>,
+    walls: &mut Vec<TruthWall>,
+    framing: &mut Vec<Ref>,
+) -> Ref {
+    let opts = ctx.opts;
+    let level = Vec3::new(0.0, 0.0, s.elevation);
+    let a2p = ctx.placement3d(level, Vec3::z(), Vec3::x());
+    let s_lp = ctx.local_placement(Some(building_lp), a2p);
+    let args = format!(
+        "{},{},$,$,{s_lp},$,$,.ELEMENT.,{}",
+        ctx.owner_args(&format!("storey:{key}")),
+        string(&s.name),
+        Real(s.elevation * ctx.scale)
+    );
+    let storey = ctx.w.add("IFCBUILDINGSTOREY", args);
+    let storey_origin = b.origin + level;
+    let place_names = PlaceNames {
+        building: &b.name,
+        storey: &s.name,
+    };
+    let mut contained = Vec::new();
+    for wall in &s.walls {
+        let parent = write_parent(ctx, storey_origin, wall, s_lp);
+        let (parent_ref, parent_lp, parent_gid) = match parent {
+            Some((r, lp, gid)) => (Some(r), Some(lp), Some(gid)),
+            None => (None, None, None),
+        };
+        let place = WallPlacement {
+            wall,
+            storey_origin,
+            storey_lp: s_lp,
+            parent_lp,
+            base,
+        };
+        let products = if opts.mapped {
+            write_mapped_wall(ctx, &place, &place_names, parent_gid.clone(), members)
+        } else {
+            write_piece_products(ctx, &place, &place_names, parent_gid.clone(), members)
+        };
+        if opts.property_sets {
+            for (k, &product) in products.iter().enumerate() {
+                write_property_set(ctx, wall, k, product);
+            }
+        }
+        let first = members.len() - wall.pieces.len();
+        walls.push(truth_wall(
+            wall,
+            &place_names,
+            parent_gid,
+            opts.grouping,
+            &members[first..],
+        ));
+        match (parent_ref, parent_lp) {
+            (Some(p), Some(lp)) => {
+                let rel = ctx.owner_args(&format!("rel:wall:{}", wall.id));
+                ctx.w.add(
+                    "IFCRELAGGREGATES",
+                    format_args!("{rel},$,$,{p},{}", RefList(&products)),
+                );
+                contained.push(p);
+                if opts.openings {
+                    contained.extend(write_openings(ctx, wall, p, lp));
+                }
+            }
+            _ => contained.extend_from_slice(&products),
+        }
+        framing.extend(products);
+    }
+    let rel = ctx.owner_args(&format!("rel:contain:{key}"));
+    ctx.w.add(
+        "IFCRELCONTAINEDINSPATIALSTRUCTURE",
+        format_args!("{rel},$,$,{},{storey}", RefList(&contained)),
+    );
+    storey
+}
+
+/// The building and storey names the truth file gives each wall and member.
+struct PlaceNames<'a> {
+    building: &'a str,
+    storey: &'a str,
+}
+
+/// A property set of the product's common set (`Pset_MemberCommon`, …) for the k-th
+/// product of a wall: its reference tag, load bearing, exterior.
+fn write_property_set(ctx: &mut Ctx, wall: &WallLayout, k: usize, product: Ref) {
+    let pset_name = match ctx.opts.products {
+        ProductClasses::Member => "Pset_MemberCommon",
+        ProductClasses::ColumnBeam if wall.pieces.get(k).is_some_and(|p| p.role.is_vertical()) => {
+            "Pset_ColumnCommon"
+        }
+        ProductClasses::ColumnBeam => "Pset_BeamCommon",
+    };
+    let tag = if ctx.opts.mapped {
+        format!("{}-{}", wall.id, ["studs", "plates"][k.min(1)])
+    } else {
+        format!("{}-{:03}", wall.id, k + 1)
+    };
+    let reference = ctx.w.add(
+        "IFCPROPERTYSINGLEVALUE",
+        format_args!("'Reference',$,IFCIDENTIFIER({}),$", string(&tag)),
+    );
+    let load = ctx.w.add(
+        "IFCPROPERTYSINGLEVALUE",
+        "'LoadBearing',$,IFCBOOLEAN(.T.),$",
+    );
+    let external = ctx
+        .w
+        .add("IFCPROPERTYSINGLEVALUE", "'IsExternal',$,IFCBOOLEAN(.T.),$");
+    let key = format!("pset:{}:{k}", wall.id);
+    let pset = ctx.w.add(
+        "IFCPROPERTYSET",
+        format_args!(
+            "{},{},$,({reference},{load},{external})",
+            ctx.owner_args(&key),
+            string(pset_name)
+        ),
+    );
+    let rel = ctx.owner_args(&format!("rel:{key}"));
+    ctx.w.add(
+        "IFCRELDEFINESBYPROPERTIES",
+        format_args!("{rel},$,$,({product}),{pset}"),
+    );
+}
+
+/// Depth of a door leaf or window unit across the wall, metres.
+const FILLING_DEPTH: f64 = 0.05;
+
+/// For each rough opening of a grouped wall: an IfcOpeningElement voiding the wall and the
+/// IfcDoor or IfcWindow filling it, both boxes in the wall's placement. Returns the fillings
+/// (contained in the storey).
+fn write_openings(ctx: &mut Ctx, wall: &WallLayout, wall_ref: Ref, wall_lp: Ref) -> Vec<Ref> {
+    let mut fillings = Vec::with_capacity(wall.openings.len());
+    for (k, o) in wall.openings.iter().enumerate() {
+        let (u, v) = (o.rough_opening_u, o.rough_opening_v);
+        let (width, height) = (u[1] - u[0], v[1] - v[0]);
+        // Wall placement axes: x = u, y = -w (the outer face at y = 0, inside at -thickness), z = v.
+        let corner = Vec3::new(u[0], -wall.thickness, v[0]);
+        let key = format!("opening:{}:{k}", wall.id);
+        let body = ctx.box_body(Vec3::new(width, wall.thickness, height));
+        let a2p = ctx.placement3d(corner, Vec3::z(), Vec3::x());
+        let lp = ctx.local_placement(Some(wall_lp), a2p);
+        let opening = ctx.w.add(
+            "IFCOPENINGELEMENT",
+            format_args!(
+                "{},'Rough opening',$,$,{lp},{body},$,.OPENING.",
+                ctx.owner_args(&key)
+            ),
+        );
+        let rel = ctx.owner_args(&format!("rel:void:{key}"));
+        ctx.w.add(
+            "IFCRELVOIDSELEMENT",
+            format_args!("{rel},$,$,{wall_ref},{opening}"),
+        );
+        let inset = Vec3::new(0.0, (wall.thickness - FILLING_DEPTH) / 2.0, 0.0);
+        let a2p = ctx.placement3d(inset, Vec3::z(), Vec3::x());
+        let f_lp = ctx.local_placement(Some(lp), a2p);
+        let f_body = ctx.box_body(Vec3::new(width, FILLING_DEPTH, height));
+        let f_key = format!("filling:{}:{k}", wall.id);
+        let head = format!(
+            "{},{},$,$,{f_lp},{f_body},$",
+            ctx.owner_args(&f_key),
+            string(o.kind)
+        );
+        let size = format!("{},{}", Real(height * ctx.scale), Real(width * ctx.scale));
+        let filling = match (o.kind, ctx.opts.schema) {
+            ("door", Schema::Ifc2x3) => ctx.w.add("IFCDOOR", format_args!("{head},{size}")),
+            ("door", _) => ctx.w.add(
+                "IFCDOOR",
+                format_args!("{head},{size},.DOOR.,.SINGLE_SWING_LEFT.,$"),
+            ),
+            (_, Schema::Ifc2x3) => ctx.w.add("IFCWINDOW", format_args!("{head},{size}")),
+            _ => ctx.w.add(
+                "IFCWINDOW",
+                format_args!("{head},{size},.WINDOW.,.SINGLE_PANEL.,$"),
+            ),
+        };
+        let rel = ctx.owner_args(&format!("rel:fill:{key}"));
+        ctx.w.add(
+            "IFCRELFILLSELEMENT",
+            format_args!("{rel},$,$,{opening},{filling}"),
+        );
+        fillings.push(filling);
+    }
+    fillings
 }
 
 /// The IfcWall or IfcElementAssembly a wall's members are aggregated into, if any:
 /// (entity, its local placement, GlobalId).
 fn write_parent(
     ctx: &mut Ctx,
-    b: &BuildingLayout,
+    storey_origin: Vec3,
     wall: &WallLayout,
     storey_lp: Ref,
 ) -> Option<(Ref, Ref, String)> {
@@ -555,7 +756,11 @@ fn write_parent(
         Grouping::Wall => "IFCWALL",
         Grouping::Assembly => "IFCELEMENTASSEMBLY",
     };
-    let a2p = ctx.placement3d(wall.frame.origin - b.origin, wall.frame.v, wall.frame.u);
+    let a2p = ctx.placement3d(
+        wall.frame.origin - storey_origin,
+        wall.frame.v,
+        wall.frame.u,
+    );
     let lp = ctx.local_placement(Some(storey_lp), a2p);
     let key = format!("wall:{}", wall.id);
     let gid = ctx.gid(&key);
@@ -579,7 +784,8 @@ fn write_parent(
 /// Where a wall's products are placed.
 struct WallPlacement<'a> {
     wall: &'a WallLayout,
-    building_origin: Vec3,
+    /// World position of the storey's placement.
+    storey_origin: Vec3,
     storey_lp: Ref,
     parent_lp: Option<Ref>,
     base: PlacementBase,
@@ -597,7 +803,7 @@ impl WallPlacement<'_> {
                 ctx.local_placement(Some(parent), a2p)
             }
             _ => {
-                let a2p = ctx.placement3d(snap_point(p - self.building_origin), f.v, f.u);
+                let a2p = ctx.placement3d(snap_point(p - self.storey_origin), f.v, f.u);
                 ctx.local_placement(Some(self.storey_lp), a2p)
             }
         }
@@ -621,7 +827,7 @@ fn product_line(schema: Schema, kind: ProductKind, head: &str) -> String {
 fn write_piece_products(
     ctx: &mut Ctx,
     place: &WallPlacement,
-    b: &BuildingLayout,
+    b: &PlaceNames,
     parent_gid: Option<String>,
     members: &mut Vec<TruthMember>,
 ) -> Vec<Ref> {
@@ -713,7 +919,7 @@ fn piece_name(wall: &WallLayout, piece: &Piece, k: usize) -> String {
 fn write_mapped_wall(
     ctx: &mut Ctx,
     place: &WallPlacement,
-    b: &BuildingLayout,
+    b: &PlaceNames,
     parent_gid: Option<String>,
     members: &mut Vec<TruthMember>,
 ) -> Vec<Ref> {
@@ -807,7 +1013,7 @@ fn truth_member(
     kind: ProductKind,
     schema: Schema,
     wall: &WallLayout,
-    b: &BuildingLayout,
+    b: &PlaceNames,
     wall_global_id: Option<String>,
     piece: &Piece,
 ) -> TruthMember {
@@ -821,8 +1027,8 @@ fn truth_member(
             .then_some(kind.predefined),
         wall_id: wall.id.clone(),
         wall_global_id,
-        building: b.name.clone(),
-        storey: b.storey_name.clone(),
+        building: b.building.to_string(),
+        storey: b.storey.to_string(),
         role: piece.role.as_str(),
         role_detail: piece.role_detail.clone(),
         nominal: piece.nominal.clone(),
@@ -848,7 +1054,7 @@ fn truth_member(
 
 fn truth_wall(
     wall: &WallLayout,
-    b: &BuildingLayout,
+    b: &PlaceNames,
     wall_global_id: Option<String>,
     grouping: Grouping,
     members: &[TruthMember],
@@ -880,8 +1086,8 @@ fn truth_wall(
             Grouping::Assembly => Some("IfcElementAssembly"),
         },
         name: wall.name.clone(),
-        building: b.name.clone(),
-        storey: b.storey_name.clone(),
+        building: b.building.to_string(),
+        storey: b.storey.to_string(),
         length: q(wall.length),
         height: q(wall.height),
         thickness: q(wall.thickness),

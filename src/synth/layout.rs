@@ -194,13 +194,40 @@ pub struct WallLayout {
     pub openings: Vec<OpeningRecord>,
 }
 
-/// A building: its walls on one storey, and where its own placement sits (world).
+/// One storey of a building: its walls (world coordinates) and its floor level.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StoreyLayout {
+    pub name: String,
+    /// Height of the storey's floor above the building's origin, metres.
+    pub elevation: f64,
+    pub walls: Vec<WallLayout>,
+}
+
+/// A building: its storeys, and where its own placement sits (world).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BuildingLayout {
     pub name: String,
     pub origin: Vec3,
-    pub storey_name: String,
-    pub walls: Vec<WallLayout>,
+    pub storeys: Vec<StoreyLayout>,
+}
+
+impl BuildingLayout {
+    /// A building whose walls all stand on one storey, "Level 1", at the building's origin.
+    pub fn one_storey(name: &str, origin: Vec3, walls: Vec<WallLayout>) -> BuildingLayout {
+        BuildingLayout {
+            name: name.to_string(),
+            origin,
+            storeys: vec![StoreyLayout {
+                name: "Level 1".into(),
+                elevation: 0.0,
+                walls,
+            }],
+        }
+    }
+
+    pub fn walls(&self) -> impl Iterator<Item = &WallLayout> {
+        self.storeys.iter().flat_map(|s| s.walls.iter())
+    }
 }
 
 /// Everything one file holds.
@@ -214,7 +241,7 @@ pub struct Layout {
 
 impl Layout {
     pub fn walls(&self) -> impl Iterator<Item = &WallLayout> {
-        self.buildings.iter().flat_map(|b| b.walls.iter())
+        self.buildings.iter().flat_map(BuildingLayout::walls)
     }
 
     pub fn piece_count(&self) -> usize {

@@ -24,12 +24,11 @@ pub fn single_wall(name: &str, description: &str, spec: &WallSpec) -> Result<Lay
     Ok(Layout {
         name: name.to_string(),
         description: description.to_string(),
-        buildings: vec![BuildingLayout {
-            name: "Building".into(),
-            origin: Vec3::zeros(),
-            storey_name: "Level 1".into(),
-            walls: vec![wall],
-        }],
+        buildings: vec![BuildingLayout::one_storey(
+            "Building",
+            Vec3::zeros(),
+            vec![wall],
+        )],
     })
 }
 

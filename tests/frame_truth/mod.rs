@@ -193,7 +193,7 @@ fn turn(layout: &mut synth::Layout, angle: f64) {
     let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), angle);
     for b in &mut layout.buildings {
         b.origin = r * b.origin;
-        for w in &mut b.walls {
+        for w in b.storeys.iter_mut().flat_map(|s| s.walls.iter_mut()) {
             let f = &mut w.frame;
             (f.origin, f.u, f.v, f.w) = (r * f.origin, r * f.u, r * f.v, r * f.w);
             for p in &mut w.pieces {

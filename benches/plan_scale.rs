@@ -1,0 +1,122 @@
+//! The scale row of `plan`: a generated model shaped like a real project (3 blocks x 5
+//! storeys, members aggregated in IfcWall, doors and windows, a property set per member:
+//! `framewright synth block --grouping wall --psets --openings`, 1,620 walls, 49,410
+//! members, 46 MB), planned with the study's cell (placement search on) the way
+//! `framewright plan --json` does it, phase by phase; then the same with the rule base run
+//! per storey and no search cache (the path before per-wall reasoning), and the ratio.
+//!
+//! `cargo bench --bench plan_scale` (`-- --storeys 1` for a quick run; `-- --skip-old` to
+//! time only the current path; `PLAN_SCALE_SIZES=1` also prints the largest relations).
+//! Peak memory: `/usr/bin/time -v framewright plan --json M.ifc`.
+
+use framewright::cell::Cell;
+use framewright::frame::placement::{SearchOptions, add_placement_facts_with};
+use framewright::frame::plan::Plan;
+use framewright::frame::{RuleEngine, cell_facts, model_facts, reason};
+use framewright::ifc::Model;
+use framewright::report::plan::PlanReport;
+use framewright::synth::building::{BlockSpec, blocks};
+use framewright::synth::units::feet;
+use framewright::synth::{Grouping, WriteOptions, models, write_ifc};
+use std::path::Path;
+use std::time::Instant;
+
+/// Runs `plan --json` on `path`, printing each phase; returns the total seconds and the JSON.
+fn plan(path: &Path, options: &SearchOptions, label: &str) -> (f64, Vec<u8>) {
+    let start = Instant::now();
+    let mut last = start;
+    let mut lap = |what: &str| {
+        let now = Instant::now();
+        eprintln!("  {label} {what:<28} {:7.3} s", (now - last).as_secs_f64());
+        last = now;
+    };
+    let model = Model::open(path).expect("read");
+    lap("read");
+    let cell = Cell::load("study-abb").expect("cell");
+    let mut facts = model_facts(&model, &Default::default());
+    facts.extend(cell_facts(&cell));
+    lap("facts and contacts");
+    add_placement_facts_with(&mut facts, &cell, &RuleEngine::Compiled, options).expect("placement");
+    lap("placement search (1st pass)");
+    let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");
+    lap("rule base");
+    if std::env::var_os("PLAN_SCALE_SIZES").is_some() {
+        let mut sizes: Vec<(usize, &String)> = reasoned
+            .relations
+            .iter()
+            .map(|(n, t)| (t.len(), n))
+            .collect();
+        sizes.sort();
+        for (n, name) in sizes.iter().rev().take(15) {
+            eprintln!("    {name} {n}");
+        }
+    }
+    let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
+    lap("typed plan");
+    let mut json = Vec::new();
+    report.write_json(&mut json).expect("json");
+    lap("JSON");
+    (start.elapsed().as_secs_f64(), json)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let storeys = args
+        .iter()
+        .position(|a| a == "--storeys")
+        .and_then(|i| args.get(i + 1)?.parse().ok())
+        .unwrap_or(5);
+    let skip_old = args.iter().any(|a| a == "--skip-old");
+    let spec = BlockSpec {
+        unit: framewright::synth::building::BuildingSpec {
+            length: feet(24.0),
+            depth: feet(14.0),
+            ..models::default_building_spec()
+        },
+        blocks: 3,
+        storeys,
+        rows: 3,
+        cols: 9,
+        gap: 3.0,
+        floor_depth: 0.3,
+    };
+    let layout = blocks(&spec, "plan_scale").expect("layout");
+    let written = write_ifc(
+        &layout,
+        &WriteOptions {
+            grouping: Grouping::Wall,
+            property_sets: true,
+            openings: true,
+            file_name: "plan_scale.ifc".into(),
+            ..WriteOptions::default()
+        },
+    )
+    .expect("write");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("plan_scale.ifc");
+    std::fs::write(&path, &written.ifc).expect("write model");
+    eprintln!(
+        "plan_scale: {} walls, {} members, {:.1} MB",
+        written.truth.counts.walls,
+        written.truth.counts.members,
+        written.ifc.len() as f64 / 1e6
+    );
+    let (now, json) = plan(&path, &SearchOptions::default(), "shared");
+    println!("plan_scale shared search:   {now:.2} s");
+    if skip_old {
+        return;
+    }
+    let (before, old_json) = plan(
+        &path,
+        &SearchOptions {
+            share_equal_poses: false,
+        },
+        "own   ",
+    );
+    println!("plan_scale search per target: {before:.2} s");
+    println!(
+        "plan_scale speed-up: {:.1}x (same JSON: {})",
+        before / now,
+        json == old_json
+    );
+}
