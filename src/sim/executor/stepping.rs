@@ -112,7 +112,7 @@ impl<'a> WallRun<'a> {
     /// Whether nothing in the world moves unless the robot pushes it: no lumber on running
     /// belts, and every piece at rest for CALM_STEPS solver steps since the last change.
     fn world_quiet(&self) -> bool {
-        !(self.phys.belts.running && !self.on_belts.is_empty())
+        (!self.phys.belts.running || self.on_belts.is_empty())
             && self.events.generation == self.phys.generation()
             && self.events.calm_steps >= CALM_STEPS
     }
