@@ -1,5 +1,5 @@
-//! Content keys. A wall's simulation reads the cell (robot, tool, layout), the time step and
-//! speed, the wall's laid-flat frame and its pieces (sizes, masses, spawn and target poses),
+//! Content keys. A wall's simulation reads the cell (robot, tool, layout), the time step,
+//! speed and stepping mode (fixed and event-driven runs agree on verdicts, not to the bit), the wall's laid-flat frame and its pieces (sizes, masses, spawn and target poses),
 //! and its nailing targets; the rules reach it only through those derived values. The key
 //! hashes exactly these, plus the build of the program, so an edit to one wall keeps the
 //! other walls' keys, and a new cell, rule change that moves a target, or new build misses.
@@ -59,9 +59,10 @@ pub fn wall_key(
     let _ = write!(t, "{cell:?}\u{0}");
     let _ = write!(
         t,
-        "dt {:016x} speed {:016x}\u{0}",
+        "dt {:016x} speed {:016x} stepping {}\u{0}",
         options.dt.to_bits(),
-        options.speed.to_bits()
+        options.speed.to_bits(),
+        options.stepping.name()
     );
     let _ = write!(t, "{wall:?}\u{0}");
     for p in pieces {
@@ -108,7 +109,7 @@ mod tests {
     }
 
     #[test]
-    fn keys_are_stable_distinct_per_wall_and_change_with_build_cell_and_step() {
+    fn keys_are_stable_distinct_per_wall_and_change_with_build_cell_step_and_stepping() {
         let cell = Cell::load("study-abb").unwrap();
         let options = SimOptions::default();
         let base = keys("b1", &cell, &options);
@@ -131,6 +132,14 @@ mod tests {
             ..SimOptions::default()
         };
         assert!(differ(keys("b1", &cell, &slower)));
+        let fixed = SimOptions {
+            stepping: crate::sim::Stepping::Fixed,
+            ..SimOptions::default()
+        };
+        assert!(
+            differ(keys("b1", &cell, &fixed)),
+            "fixed-step results are not reused for event-driven runs"
+        );
         let mut moved_tool = cell.clone();
         moved_tool.tool.parts[1].shape.origin.translation.x += 0.01;
         assert!(

@@ -9,7 +9,7 @@ use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::report::html::{ReportInput, write_report};
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, simulate_with_progress};
+use framewright::sim::{SimOptions, Stepping, simulate_with_progress};
 use framewright::user_rules::UserRules;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
@@ -51,6 +51,11 @@ pub struct SimulateArgs {
     /// Fraction of the cell's programmed speeds to move at (0..1].
     #[arg(long, default_value_t = 1.0)]
     pub speed: f64,
+    /// When the physics steps: `events` steps only while lumber can move on its own (belts,
+    /// settling, the robot touching a loose piece); `fixed` steps at every time step (slower;
+    /// for comparison).
+    #[arg(long, value_enum, default_value_t = Stepping::Events)]
+    pub stepping: Stepping,
     /// Where walls lie along the robot's x axis, overriding the cell: metres from the base
     /// to the wall's bottom edge, or `auto` (each wall where the arm reaches most of it).
     #[arg(long, value_name = "M|auto")]
@@ -72,6 +77,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         walls: args.walls,
         dt: args.step_ms / 1000.0,
         speed: args.speed,
+        stepping: args.stepping,
         engine: args
             .rules_dir
             .map_or(RuleEngine::Compiled, RuleEngine::Directory),

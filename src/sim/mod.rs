@@ -34,6 +34,29 @@ pub struct SimOptions {
     pub speed: f64,
     /// The rule base for reasoning and verdicts.
     pub engine: RuleEngine,
+    /// When rapier steps: every time step, or only while something can move on its own.
+    pub stepping: Stepping,
+}
+
+/// How the executor advances time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Stepping {
+    /// rapier steps at every time step of the run.
+    Fixed,
+    /// rapier steps only while lumber is loose (running belts, settling, a robot touching a
+    /// loose piece); while nothing can move on its own the robot's motion is advanced without
+    /// the solver, its contacts found by collision queries.
+    #[default]
+    Events,
+}
+
+impl Stepping {
+    pub fn name(self) -> &'static str {
+        match self {
+            Stepping::Fixed => "fixed",
+            Stepping::Events => "events",
+        }
+    }
 }
 
 impl Default for SimOptions {
@@ -43,6 +66,7 @@ impl Default for SimOptions {
             dt: 1.0 / 240.0,
             speed: 1.0,
             engine: RuleEngine::Compiled,
+            stepping: Stepping::Events,
         }
     }
 }

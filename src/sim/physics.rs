@@ -114,6 +114,20 @@ pub struct Physics {
     /// Lumber id by collider.
     lumber_of: HashMap<ColliderHandle, String>,
     cell: Cell,
+    /// Counts the changes to what is in the world and how it may move (lumber added, removed,
+    /// gripped, released, clamped, nailed; jaws; belts): a clearance measured at one count
+    /// holds only at that count.
+    generation: u64,
+}
+
+/// How far the robot, its tool and a held piece are from the rest of the world (m), each
+/// capped at the reach asked for.
+#[derive(Debug, Clone, Copy)]
+pub struct Clearance {
+    /// To anything they can touch (fixed bodies, clamped and loose lumber).
+    pub any: f64,
+    /// To lumber that can move (dynamic bodies).
+    pub loose: f64,
 }
 
 impl Physics {
@@ -357,11 +371,13 @@ impl Physics {
             names,
             lumber_of: HashMap::new(),
             cell: cell.clone(),
+            generation: 0,
         }
     }
 
     /// Puts a lumber piece into the world at `pose` (cell frame), at rest.
     pub fn add_lumber(&mut self, piece: &ScenePiece, pose: &Isometry3<f64>) {
+        self.generation += 1;
         let [l, w, t] = piece.size.map(|v| v as f32 / 2.0);
         // Lumber on a belt never sleeps: the slow infeed belt moves it below rapier's sleep
         // threshold. Placed pieces may sleep again (see `detach`).
@@ -388,6 +404,7 @@ impl Physics {
 
     /// Takes a piece out of the world (an operator lifts it off the belt).
     pub fn remove_lumber(&mut self, id: &str) {
+        self.generation += 1;
         if let Some(b) = self.lumber.remove(id) {
             self.world.remove_body_with_colliders(b.body, true);
             self.lumber_of.remove(&b.collider);
@@ -423,6 +440,7 @@ impl Physics {
     /// A framing table under the wall when the cell's assembly surface is above the floor:
     /// a solid block from the floor to `top` over the cell-frame rectangle `min`..`max`.
     pub fn add_assembly_table(&mut self, min: [f64; 2], max: [f64; 2], top: f64) {
+        self.generation += 1;
         let floor = self.cell.floor.z;
         let height = top - floor;
         if height <= 0.0 {
@@ -447,6 +465,7 @@ impl Physics {
 
     /// Opens the jaws (`None`) or closes them on lumber of this thickness.
     pub fn set_jaws(&mut self, closed_on: Option<f64>) {
+        self.generation += 1;
         let open = self
             .cell
             .tool
@@ -463,6 +482,7 @@ impl Physics {
 
     /// Holds a piece rigidly in the gripper: it becomes position-driven (it follows the tool).
     pub fn attach(&mut self, id: &str) {
+        self.generation += 1;
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::KinematicPositionBased, true);
         }
@@ -470,6 +490,7 @@ impl Physics {
 
     /// Lets go of a piece: it is a dynamic body again, at rest where it is.
     pub fn detach(&mut self, id: &str) {
+        self.generation += 1;
         if let Some(b) = self.lumber.get(id) {
             let body = &mut self.world.bodies[b.body];
             body.set_body_type(RigidBodyType::Dynamic, true);
@@ -486,6 +507,7 @@ impl Physics {
     /// The fixture holds a placed piece where it came to rest (a framing table's stops and
     /// clamps): it no longer moves, whatever touches it later.
     pub fn clamp(&mut self, id: &str) {
+        self.generation += 1;
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::Fixed, true);
         }
@@ -500,6 +522,7 @@ impl Physics {
 
     /// Joins two pieces where they are (a nail).
     pub fn nail(&mut self, a: &str, b: &str) {
+        self.generation += 1;
         let (Some(a), Some(b)) = (self.lumber.get(a).copied(), self.lumber.get(b).copied()) else {
             return;
         };
@@ -514,6 +537,7 @@ impl Physics {
 
     /// Starts or stops both belts; a started belt wakes the lumber on it.
     pub fn set_belts(&mut self, running: bool) {
+        self.generation += 1;
         if running && !self.belts.running {
             let bodies: Vec<RigidBodyHandle> = self.lumber.values().map(|b| b.body).collect();
             for b in bodies {
@@ -526,6 +550,155 @@ impl Physics {
     /// One physics step.
     pub fn step(&mut self) {
         self.world.step_with_events(&self.belts, &());
+    }
+
+    /// The count of changes to the world's contents (see `generation`).
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Puts the robot's bodies (and the held piece, at `in_tool` in tool0) at joint values
+    /// `q` at once, without a step: nothing is pushed and no velocity results.
+    pub fn place_robot(&mut self, q: &[f64], held: Option<(&str, &Isometry3<f64>)>) {
+        let poses = self.cell.robot.fk_all(q);
+        for &(i, body) in &self.links {
+            let pose = to_pose(&(self.cell.robot_base * poses[i]));
+            self.world.bodies[body].set_position(pose, false);
+        }
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(q);
+        self.world.bodies[self.tool].set_position(to_pose(&tool), false);
+        if let Some((id, in_tool)) = held
+            && let Some(b) = self.lumber.get(id)
+        {
+            self.world.bodies[b.body].set_position(to_pose(&(tool * in_tool)), false);
+        }
+    }
+
+    /// Updates the contacts for where the bodies are now, without advancing time (no solver,
+    /// nothing moves).
+    pub fn detect(&mut self) {
+        self.world.detect_collisions(&self.belts, &());
+    }
+
+    /// Whether every dynamic lumber body moves slower than `linear` (m/s) and `angular` (rad/s).
+    pub fn lumber_calm(&self, linear: f64, angular: f64) -> bool {
+        self.lumber.values().all(|b| {
+            let body = &self.world.bodies[b.body];
+            !body.is_dynamic()
+                || (f64::from(body.linvel().length()) < linear
+                    && f64::from(body.angvel().length()) < angular)
+        })
+    }
+
+    /// The robot's colliders (base link excluded: it never moves) and the held piece's, with
+    /// their cell-frame poses at joint values `q`.
+    fn robot_shapes_at(
+        &self,
+        q: &[f64],
+        held: Option<(&str, &Isometry3<f64>)>,
+    ) -> Vec<(ColliderHandle, Isometry3<f64>)> {
+        let poses = self.cell.robot.fk_all(q);
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(q);
+        let mut shapes = Vec::with_capacity(self.robot_colliders.len() + 1);
+        for &c in &self.robot_colliders {
+            let collider = &self.world.colliders[c];
+            let Some(parent) = collider.parent() else {
+                continue;
+            };
+            let body = if parent == self.tool {
+                tool
+            } else {
+                match self.links.iter().find(|l| l.1 == parent) {
+                    Some(&(0, _)) | None => continue,
+                    Some(&(i, _)) => self.cell.robot_base * poses[i],
+                }
+            };
+            let local = collider
+                .position_wrt_parent()
+                .map_or_else(Isometry3::identity, to_iso);
+            shapes.push((c, body * local));
+        }
+        if let Some((id, in_tool)) = held
+            && let Some(b) = self.lumber.get(id)
+        {
+            shapes.push((b.collider, tool * in_tool));
+        }
+        shapes
+    }
+
+    /// Corners of the local bounding boxes of the robot's moving colliders and the held piece
+    /// at joint values `q`: no point of them moves further than the furthest-moving corner
+    /// (a rigid motion moves a box's points at most as far as its furthest corner).
+    pub fn robot_corners(
+        &self,
+        q: &[f64],
+        held: Option<(&str, &Isometry3<f64>)>,
+    ) -> Vec<Vector3<f64>> {
+        let mut corners = Vec::new();
+        for (c, pose) in self.robot_shapes_at(q, held) {
+            let aabb = self.world.colliders[c].shape().compute_local_aabb();
+            let (lo, hi) = (aabb.mins, aabb.maxs);
+            for k in 0..8 {
+                let pick = |bit: usize, a: f32, b: f32| f64::from(if k & bit == 0 { a } else { b });
+                let local = nalgebra::Point3::new(
+                    pick(1, lo.x, hi.x),
+                    pick(2, lo.y, hi.y),
+                    pick(4, lo.z, hi.z),
+                );
+                corners.push((pose * local).coords);
+            }
+        }
+        corners
+    }
+
+    /// How far the robot, its tool and the held piece at joint values `q` are from everything
+    /// else they can touch, and from loose lumber; distances beyond `reach` read as `reach`.
+    pub fn clearance(
+        &self,
+        q: &[f64],
+        held: Option<(&str, &Isometry3<f64>)>,
+        reach: f64,
+    ) -> Clearance {
+        let mut own: Vec<RigidBodyHandle> = self.links.iter().map(|l| l.1).collect();
+        own.push(self.tool);
+        if let Some(b) = held.and_then(|(id, _)| self.lumber.get(id)) {
+            own.push(b.body);
+        }
+        let predicate = |_: ColliderHandle, c: &Collider| {
+            !c.is_sensor() && !c.parent().is_some_and(|b| own.contains(&b))
+        };
+        let mut found = Clearance {
+            any: reach,
+            loose: reach,
+        };
+        for (c, pose) in self.robot_shapes_at(q, held) {
+            let collider = &self.world.colliders[c];
+            let shape = collider.shape();
+            let pose = to_pose(&pose);
+            let (grown, centre) = grown_box(shape, reach);
+            let filter = QueryFilter::default()
+                .groups(collider.collision_groups())
+                .predicate(&predicate);
+            for (_, other) in self.world.intersect_shape(pose * centre, &grown, filter) {
+                let Ok(d) =
+                    rapier3d::parry::query::distance(&pose, shape, other.position(), other.shape())
+                else {
+                    // A pair parry cannot measure counts as touching.
+                    found.any = 0.0;
+                    found.loose = 0.0;
+                    continue;
+                };
+                let d = f64::from(d.distance);
+                found.any = found.any.min(d);
+                let loose = other
+                    .parent()
+                    .is_some_and(|b| self.world.bodies[b].is_dynamic());
+                if loose {
+                    found.loose = found.loose.min(d);
+                }
+            }
+        }
+        found
     }
 
     /// The lumber pieces in the sensor zone.
@@ -592,6 +765,15 @@ impl Physics {
             .map(|(id, b)| (id.clone(), to_iso(self.world.bodies[b.body].position())))
             .collect()
     }
+}
+
+/// A box covering everything within `margin` of `shape` (its bounding box grown by the
+/// margin, a coarse candidate filter; exact distances are measured afterwards) and the box's
+/// centre in the shape's frame.
+fn grown_box(shape: &dyn rapier3d::parry::shape::Shape, margin: f64) -> (Cuboid, Pose) {
+    let aabb = shape.compute_local_aabb();
+    let half = aabb.half_extents() + Vector::splat(margin as f32);
+    (Cuboid::new(half), Pose::from_translation(aabb.center()))
 }
 
 impl Finger {

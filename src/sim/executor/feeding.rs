@@ -195,7 +195,7 @@ impl<'a> WallRun<'a> {
                     .unwrap_or_default();
                 return Err(format!("it did not arrive within {limit:.0} s{where_}"));
             }
-            self.step();
+            self.tick();
         }
     }
 

@@ -14,6 +14,7 @@ mod feeding;
 mod framing;
 mod nailing;
 mod paths;
+mod stepping;
 
 pub use nailing::NailPlan;
 
@@ -65,6 +66,8 @@ pub struct WallRun<'a> {
     placed: BTreeMap<String, Isometry3<f64>>,
     record: WallRecord,
     progress: &'a (dyn Fn(usize, usize) + Sync),
+    /// Event-driven stepping's state (unused with fixed steps).
+    events: stepping::Events,
 }
 
 impl<'a> WallRun<'a> {
@@ -93,7 +96,7 @@ impl<'a> WallRun<'a> {
             wall_cell: cell.robot_base * wall.wall_to_robot,
             pieces,
             t: 0.0,
-            q,
+            q: q.clone(),
             held: None,
             current: None,
             resting: BTreeSet::new(),
@@ -107,6 +110,7 @@ impl<'a> WallRun<'a> {
                 ..WallRecord::default()
             },
             progress,
+            events: stepping::Events::new(&q),
         }
     }
 
@@ -164,7 +168,7 @@ impl<'a> WallRun<'a> {
         self.cell.motion.nail_approach_speed * self.options.speed
     }
 
-    /// One physics step: the robot follows `q`, a held piece follows the tool, the feeder and
+    /// One physics step (see `tick` for the step the run takes): the robot follows `q`, a held piece follows the tool, the feeder and
     /// the sensor act, contacts are recorded.
     fn step(&mut self) {
         self.phys.drive_robot(&self.q);
@@ -188,7 +192,7 @@ impl<'a> WallRun<'a> {
     fn wait(&mut self, seconds: f64) {
         let steps = (seconds / self.options.dt).ceil().max(1.0) as u64;
         for _ in 0..steps {
-            self.step();
+            self.tick();
         }
     }
 
@@ -196,7 +200,7 @@ impl<'a> WallRun<'a> {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
         for k in 1..=steps {
             self.q = mv.at(k as f64 * self.options.dt);
-            self.step();
+            self.tick();
         }
         self.q = mv.to.clone();
     }
@@ -209,7 +213,7 @@ impl<'a> WallRun<'a> {
             let next = solve(self.cell, &pose, tcp, &self.q)?;
             check_step(self.cell, &self.q, &next, k as f64 / steps as f64)?;
             self.q = next;
-            self.step();
+            self.tick();
         }
         Ok(())
     }

@@ -1,0 +1,172 @@
+//! Event-driven stepping. rapier's solver only matters while lumber can move on its own:
+//! pieces riding a running belt, settling after they were fed, stopped or released, or pushed
+//! by the robot. The rest of a run (the robot carrying a piece through free space, nailing a
+//! clamped frame, waiting with nothing loose) advances time without the solver: the robot's
+//! joints follow their motion profile tick by tick as before, the pose trace is sampled at
+//! its rate, and the robot's contacts are found where a fixed-step run would find them.
+//!
+//! Contacts without the solver: the distances from the robot, its tool and the held piece to
+//! everything else are measured at a pose; no point of them comes closer than that until
+//! they have moved that far (measured at the corners of their bounding boxes), so nothing
+//! more is measured until then. Where they touch something, rapier's collision detection
+//! runs (no time passes) and the contacts are recorded as a fixed-step run records them.
+//! Near loose lumber (within LOOSE_MARGIN) the solver steps: the robot may push it.
+
+use super::WallRun;
+use crate::sim::Stepping;
+use nalgebra::Vector3;
+
+/// Lumber slower than this is at rest (m/s, rad/s).
+const CALM_LINEAR: f64 = 2e-4;
+const CALM_ANGULAR: f64 = 2e-3;
+/// Physics steps with all lumber at rest, after the last change to the world, before the
+/// solver may pause (0.25 s at 240 Hz).
+const CALM_STEPS: u32 = 60;
+/// Within this of loose lumber the robot is stepped with the solver (m).
+const LOOSE_MARGIN: f64 = 0.02;
+/// How far a clearance measurement looks (m): the robot moves this far less LOOSE_MARGIN
+/// before the next one when nothing is near.
+const CLEARANCE_REACH: f64 = 0.10;
+/// Closer than this the robot may be touching something (m).
+const TOUCH: f64 = 1e-4;
+
+/// What event-driven stepping keeps between ticks.
+#[derive(Debug, Clone)]
+pub(super) struct Events {
+    /// Consecutive solver steps with all lumber at rest since the world last changed.
+    calm_steps: u32,
+    /// The world's change count those steps were counted at.
+    generation: u64,
+    /// The previous tick's joint values: rapier reports a step's contacts for where the
+    /// bodies stood when it began, one tick behind the joints it drives them to.
+    prev_q: Vec<f64>,
+    /// The last clearance measurement, while it holds.
+    anchor: Option<Anchor>,
+}
+
+#[derive(Debug, Clone)]
+struct Anchor {
+    corners: Vec<Vector3<f64>>,
+    /// How far the corners may move before something could be touched or loose lumber
+    /// come within LOOSE_MARGIN (m).
+    free: f64,
+    generation: u64,
+    held: Option<String>,
+}
+
+impl Events {
+    pub(super) fn new(q: &[f64]) -> Events {
+        Events {
+            calm_steps: 0,
+            generation: u64::MAX,
+            prev_q: q.to_vec(),
+            anchor: None,
+        }
+    }
+}
+
+impl<'a> WallRun<'a> {
+    /// Advances time by one step with the robot at `self.q`.
+    pub(super) fn tick(&mut self) {
+        if self.options.stepping == Stepping::Fixed {
+            self.step();
+            return;
+        }
+        if !self.world_quiet() {
+            self.solver_tick();
+            return;
+        }
+        let at = self.events.prev_q.clone();
+        let held = self.held.clone();
+        let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
+        let corners = self.phys.robot_corners(&at, held_ref);
+        let generation = self.phys.generation();
+        let within = self.events.anchor.as_ref().is_some_and(|a| {
+            a.generation == generation
+                && a.held.as_deref() == held_ref.map(|h| h.0)
+                && a.corners.len() == corners.len()
+                && a.corners
+                    .iter()
+                    .zip(&corners)
+                    .all(|(p, n)| (n - p).norm() < a.free)
+        });
+        let mut touching = false;
+        if !within {
+            let clear = self.phys.clearance(&at, held_ref, CLEARANCE_REACH);
+            if clear.loose < LOOSE_MARGIN {
+                self.events.anchor = None;
+                self.solver_tick();
+                return;
+            }
+            touching = clear.any <= TOUCH;
+            self.events.anchor = Some(Anchor {
+                corners,
+                free: clear.any.min(clear.loose - LOOSE_MARGIN),
+                generation,
+                held: held_ref.map(|h| h.0.to_string()),
+            });
+        }
+        self.quiet_tick(touching);
+    }
+
+    /// Whether nothing in the world moves unless the robot pushes it: no lumber on running
+    /// belts, and every piece at rest for CALM_STEPS solver steps since the last change.
+    fn world_quiet(&self) -> bool {
+        (!self.phys.belts.running || self.on_belts.is_empty())
+            && self.events.generation == self.phys.generation()
+            && self.events.calm_steps >= CALM_STEPS
+    }
+
+    /// A step with the solver (the robot's bodies stand where the last tick left them).
+    fn solver_tick(&mut self) {
+        let generation = self.phys.generation();
+        self.step();
+        self.events.prev_q.clone_from(&self.q);
+        if self.phys.generation() != generation || self.events.generation != generation {
+            self.events.generation = self.phys.generation();
+            self.events.calm_steps = 0;
+        }
+        if self.phys.lumber_calm(CALM_LINEAR, CALM_ANGULAR) {
+            self.events.calm_steps = self.events.calm_steps.saturating_add(1);
+        } else {
+            self.events.calm_steps = 0;
+        }
+    }
+
+    /// A step without the solver: time, the trace, the feeder and, where the robot touches
+    /// something, its contacts. The robot's bodies end the tick where a fixed step leaves
+    /// them (at `self.q`), for whatever the executor does next (grip, release, measure).
+    fn quiet_tick(&mut self, touching: bool) {
+        let held = self.held.clone();
+        let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
+        // Contacts are recorded in operations other than waiting for a piece (as `step`).
+        let watched = matches!(&self.current, Some((_, op, _)) if *op != "feed");
+        if touching && watched {
+            let prev = self.events.prev_q.clone();
+            self.phys.place_robot(&prev, held_ref);
+            self.phys.detect();
+        }
+        self.phys.place_robot(&self.q, held_ref);
+        self.t += self.options.dt;
+        self.sample_trace();
+        if touching && watched {
+            self.watch_contacts();
+        }
+        let generation = self.phys.generation();
+        self.feed();
+        if self.phys.generation() != generation {
+            self.events.anchor = None;
+        }
+        self.events.prev_q.clone_from(&self.q);
+    }
+
+    /// A trace sample, if one is due (as `step` takes it).
+    fn sample_trace(&mut self) {
+        if !self.record.trace.due(self.t) {
+            return;
+        }
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
+        let lumber = self.phys.lumber_poses();
+        self.record.trace.sample(self.t, &self.q, tool, lumber);
+    }
+}
