@@ -6,6 +6,7 @@
 use super::error::LogicError;
 use super::front::ast::IoSpec;
 use super::interp::{Engine, Origin};
+use super::io_symbols::unwritable_symbol;
 use super::value::Value;
 use std::path::{Path, PathBuf};
 
@@ -108,7 +109,18 @@ pub fn write_outputs(
     let mut stdout = String::new();
     for r in &engine.program().relations {
         let Some(spec) = &r.output else { continue };
-        let text = format_tuples(&engine.relation(&r.name)?, &spec.delimiter, r.arity());
+        let tuples = engine.relation(&r.name)?;
+        if !spec.stdout
+            && let Some((symbol, why)) = unwritable_symbol(&tuples, &spec.delimiter)
+        {
+            return Err(LogicError::Usage(format!(
+                "cannot write `{}` to {}: the symbol {symbol:?} {why}, and .facts/.csv files \
+                 hold symbols unquoted; change the rules that derive it (or the delimiter)",
+                r.name,
+                file_for(out_dir, &r.name, spec, "csv").display()
+            )));
+        }
+        let text = format_tuples(&tuples, &spec.delimiter, r.arity());
         if spec.stdout {
             stdout.push_str(&format!(
                 "---------------\n{}\n===============\n{text}===============\n",
