@@ -143,8 +143,7 @@ fn deeply_nested_urdf_is_refused_before_parsing() {
         "</a>".repeat(n)
     );
     let e = Robot::from_urdf_str(Path::new("deep.urdf"), &text, RobotMeta::default())
-        .err()
-        .expect("refused");
+        .expect_err("refused");
     let message = e.to_string();
     assert!(
         message.contains("deep.urdf")
