@@ -410,6 +410,11 @@ impl Cell {
         self.robot_base.inverse() * pose
     }
 
+    /// A cell from TOML text; `path` names it in messages and anchors relative model paths.
+    pub fn from_toml(path: &Path, text: &str) -> Result<Cell, CellError> {
+        Cell::parse(path, text, false)
+    }
+
     fn parse(path: &Path, text: &str, builtin: bool) -> Result<Cell, CellError> {
         let f: CellFile = toml_file::parse(path, text)?;
         let bad = |section: &str, key: &str, msg: String| {

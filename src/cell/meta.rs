@@ -68,7 +68,7 @@ pub struct OpwParams {
 
 impl RobotMeta {
     /// Parse a metadata file; returns the metadata and the URDF path it names (relative to `path`).
-    pub(crate) fn parse(path: &Path, text: &str) -> Result<(RobotMeta, String), CellError> {
+    pub fn parse(path: &Path, text: &str) -> Result<(RobotMeta, String), CellError> {
         let file: MetaFile = toml_file::parse(path, text)?;
         let bad = |key: &str, msg: String| {
             let (section, key) = key.split_once('.').unwrap_or(("", key));

@@ -18,6 +18,7 @@ mod shapes;
 pub mod tcp_poses;
 mod toml_file;
 mod tool;
+mod urdf_depth;
 
 pub use builtin::{cell_names, robot_names, tool_names};
 pub use error::CellError;

@@ -113,6 +113,16 @@ pub struct Robot {
 impl Robot {
     /// Build a robot from URDF text and its metadata. `path` is used in messages only.
     pub fn from_urdf_str(path: &Path, urdf: &str, meta: RobotMeta) -> Result<Robot, CellError> {
+        if let Some(line) = super::urdf_depth::too_deep(urdf) {
+            return Err(CellError::urdf(
+                path,
+                format!(
+                    "line {line}: elements nest more than {} levels deep; a robot description \
+                     needs about six (robot, link, visual, geometry, mesh)",
+                    super::urdf_depth::MAX_DEPTH
+                ),
+            ));
+        }
         let parsed =
             urdf_rs::read_from_string(urdf).map_err(|e| CellError::urdf(path, e.to_string()))?;
         let mut robot = build_tree(path, &parsed, &meta)?;

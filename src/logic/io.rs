@@ -9,6 +9,7 @@ use super::error::LogicError;
 use super::front::ast::IoSpec;
 use super::front::confine;
 use super::interp::{Engine, Origin};
+use super::io_symbols::unwritable_symbol;
 use super::value::Value;
 use std::path::{Path, PathBuf};
 
@@ -161,7 +162,8 @@ pub fn write_outputs(
     let mut stdout = String::new();
     for r in &engine.program().relations {
         let Some(spec) = &r.output else { continue };
-        let text = format_tuples(&engine.relation(&r.name)?, &spec.delimiter, r.arity());
+        let tuples = engine.relation(&r.name)?;
+        let text = format_tuples(&tuples, &spec.delimiter, r.arity());
         if spec.stdout {
             stdout.push_str(&format!(
                 "---------------\n{}\n===============\n{text}===============\n",
@@ -174,6 +176,14 @@ pub fn write_outputs(
             source,
         })?;
         let path = file_for(engine, out_dir, &r.name, spec, Direction::Output)?;
+        if let Some((symbol, why)) = unwritable_symbol(&tuples, &spec.delimiter) {
+            return Err(LogicError::Usage(format!(
+                "cannot write `{}` to {}: the symbol {symbol:?} {why}, and .facts/.csv files \
+                 hold symbols unquoted; change the rules that derive it (or the delimiter)",
+                r.name,
+                path.display()
+            )));
+        }
         if let Some(parent) = path.parent() {
             std::fs::create_dir_all(parent).map_err(|source| LogicError::Write {
                 path: parent.to_path_buf(),

@@ -13,6 +13,7 @@ pub mod front;
 pub mod functors;
 pub mod interp;
 pub mod io;
+pub mod io_symbols;
 pub mod ops;
 pub mod provenance;
 pub mod value;

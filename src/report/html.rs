@@ -8,6 +8,7 @@
 //! values by default.
 
 use super::glb;
+use super::markup_text::replace_forbidden;
 use super::simulate::SimReport;
 use super::svg;
 use super::verdict;
@@ -78,7 +79,10 @@ pub fn report_files(input: &ReportInput) -> Vec<(String, Vec<u8>)> {
             (validation(input.report))
         },
     );
-    files.push(("index.html".to_string(), index.into_string().into_bytes()));
+    files.push((
+        "index.html".to_string(),
+        replace_forbidden(index.into_string()).into_bytes(),
+    ));
     if split {
         for (i, w) in walls.iter().enumerate() {
             let body = html! {
@@ -89,7 +93,7 @@ pub fn report_files(input: &ReportInput) -> Vec<(String, Vec<u8>)> {
             let title = format!("{} — simulation report", w.row.name);
             files.push((
                 page_name(i),
-                page(input, &title, body).into_string().into_bytes(),
+                replace_forbidden(page(input, &title, body).into_string()).into_bytes(),
             ));
         }
     }

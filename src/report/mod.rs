@@ -5,6 +5,7 @@ pub mod causes;
 pub mod glb;
 pub mod html;
 pub mod inspect;
+pub mod markup_text;
 mod mesh;
 pub mod plan;
 pub mod png;

@@ -64,7 +64,9 @@ fn scale_bar(x: f64, y: f64, px_per_m: f64) -> Markup {
 /// a scale bar. `None` when the simulation has no such wall.
 pub fn elevation_svg(sim: &Simulation, report: &SimReport, wall_id: &str) -> Option<String> {
     let view = WallView::new(sim, report, None, wall_id)?;
-    Some(elevation(&view).into_string())
+    Some(super::markup_text::replace_forbidden(
+        elevation(&view).into_string(),
+    ))
 }
 
 pub(super) fn elevation(view: &WallView) -> Markup {

@@ -15,7 +15,9 @@ fn document(body: impl FnOnce(&mut W) -> io::Result<()>) -> io::Result<Vec<u8>> 
     body(&mut w)?;
     let mut out = w.into_inner();
     out.push(b'\n');
-    Ok(out)
+    // Model names may hold characters XML 1.0 forbids even escaped.
+    let text = String::from_utf8(out).map_err(io::Error::other)?;
+    Ok(crate::report::markup_text::replace_forbidden(text).into_bytes())
 }
 
 fn text(w: &mut W, name: &str, value: &str) -> io::Result<()> {

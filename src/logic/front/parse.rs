@@ -68,12 +68,22 @@ const BITWISE: [&str; 11] = [
     "band", "bor", "bxor", "bshl", "bshr", "bshru", "bnot", "land", "lor", "lxor", "lnot",
 ];
 
+/// Bounds on one item's expression tree: the parser, the checker, the engines and dropping the
+/// tree all recurse over it, so a hostile file (`((((…`, `----…`, `1+1+…+1`) must not be able
+/// to make it deep enough to overflow a thread's stack.
+const MAX_NESTING: usize = 100;
+const MAX_OPERATORS: usize = 1000;
+
 pub struct Parser<'a> {
     toks: &'a [Token],
     pos: usize,
     labels: &'a [Label],
     /// Line of the end of the previous item: labels must follow it.
     prev_end_line: u32,
+    /// Current nesting of expressions and body terms.
+    depth: usize,
+    /// Operators read in the current item.
+    operators: usize,
 }
 
 impl<'a> Parser<'a> {
@@ -83,7 +93,40 @@ impl<'a> Parser<'a> {
             pos: 0,
             labels,
             prev_end_line: 0,
+            depth: 0,
+            operators: 0,
         }
+    }
+
+    /// Runs `f` one nesting level deeper, refusing past `MAX_NESTING`.
+    fn nested<T>(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> Result<T, ParseError>,
+    ) -> Result<T, ParseError> {
+        if self.depth >= MAX_NESTING {
+            return err(
+                self.span(),
+                format!("expressions or rule bodies nest more than {MAX_NESTING} levels deep here"),
+                "compute inner parts in helper rules (or variables) instead of nesting them",
+            );
+        }
+        self.depth += 1;
+        let out = f(self);
+        self.depth -= 1;
+        out
+    }
+
+    /// Counts one operator of the current item, refusing past `MAX_OPERATORS`.
+    fn operator(&mut self) -> Result<(), ParseError> {
+        self.operators += 1;
+        if self.operators > MAX_OPERATORS {
+            return err(
+                self.span(),
+                format!("this rule holds more than {MAX_OPERATORS} operators"),
+                "split the computation over several rules with intermediate relations",
+            );
+        }
+        Ok(())
     }
 
     fn peek(&self) -> &Tok {
@@ -154,6 +197,7 @@ impl<'a> Parser<'a> {
         let mut items = Vec::new();
         while *self.peek() != Tok::Eof {
             let start = self.span();
+            self.operators = 0;
             match self.peek().clone() {
                 Tok::Directive(d) => self.directive(&d, &mut items)?,
                 _ => self.clause(&mut items)?,
@@ -513,6 +557,10 @@ impl<'a> Parser<'a> {
     }
 
     fn term(&mut self) -> Result<Vec<Vec<Literal>>, ParseError> {
+        self.nested(Self::term_inner)
+    }
+
+    fn term_inner(&mut self) -> Result<Vec<Vec<Literal>>, ParseError> {
         if self.is("!") {
             let bang = self.bump().span;
             let inner = self.term()?;
@@ -631,6 +679,10 @@ impl<'a> Parser<'a> {
     }
 
     pub fn expr(&mut self) -> Result<Expr, ParseError> {
+        self.nested(Self::sum)
+    }
+
+    fn sum(&mut self) -> Result<Expr, ParseError> {
         let mut lhs = self.term_mul()?;
         loop {
             let op = match self.peek() {
@@ -638,6 +690,7 @@ impl<'a> Parser<'a> {
                 Tok::P("-") => BinOp::Sub,
                 _ => break,
             };
+            self.operator()?;
             self.bump();
             let rhs = self.term_mul()?;
             lhs = bin(op, lhs, rhs);
@@ -668,6 +721,7 @@ impl<'a> Parser<'a> {
                 Tok::P("%") => BinOp::Rem,
                 _ => break,
             };
+            self.operator()?;
             self.bump();
             let rhs = self.unary()?;
             lhs = bin(op, lhs, rhs);
@@ -678,8 +732,9 @@ impl<'a> Parser<'a> {
 
     fn unary(&mut self) -> Result<Expr, ParseError> {
         if self.is("-") {
+            self.operator()?;
             let span = self.bump().span;
-            let inner = self.unary()?;
+            let inner = self.nested(Self::unary)?;
             return Ok(match inner.kind {
                 ExprKind::Int(i) => Expr {
                     kind: ExprKind::Int(-i),
@@ -704,7 +759,8 @@ impl<'a> Parser<'a> {
     fn power(&mut self) -> Result<Expr, ParseError> {
         let base = self.primary()?;
         if self.eat("^") {
-            let exp = self.unary()?;
+            self.operator()?;
+            let exp = self.nested(Self::unary)?;
             return Ok(bin(BinOp::Pow, base, exp));
         }
         Ok(base)
