@@ -189,6 +189,9 @@ fn bcf_documents_are_well_formed_xml_with_the_names() {
     for i in 0..archive.len() {
         let mut entry = archive.by_index(i).unwrap();
         let name = entry.name().unwrap().to_string();
+        if name.ends_with(".png") {
+            continue; // the snapshot image; bcf_export checks it
+        }
         let mut text = String::new();
         entry.read_to_string(&mut text).unwrap();
         let doc = roxmltree::Document::parse(&text)
