@@ -37,12 +37,6 @@ fn run(
     (sim, report)
 }
 
-fn json(report: &SimReport) -> String {
-    let mut out = Vec::new();
-    report.write_json(&mut out).unwrap();
-    String::from_utf8(out).unwrap()
-}
-
 /// Per element: its framing and nailing status.
 fn verdicts(report: &SimReport) -> BTreeMap<String, [String; 2]> {
     report
@@ -225,7 +219,7 @@ fn event_driven_runs_repeat_byte_for_byte() {
     let cell = Cell::load("study-abb").expect("cell");
     let (first_sim, first) = run(&model, &cell, &[], Stepping::Events);
     let (second_sim, second) = run(&model, &cell, &[], Stepping::Events);
-    assert_eq!(json(&first), json(&second));
+    assert_eq!(first.to_json(), second.to_json());
     for (a, b) in first_sim.records.iter().zip(&second_sim.records) {
         assert_eq!(a.trace.times, b.trace.times);
         assert_eq!(a.trace.joints, b.trace.joints);

@@ -39,12 +39,6 @@ fn run_cell(model_name: &str, cell: Cell, walls: &[&str]) -> (Simulation, SimRep
     (sim, report)
 }
 
-fn json(report: &SimReport) -> String {
-    let mut out = Vec::new();
-    report.write_json(&mut out).unwrap();
-    String::from_utf8(out).unwrap()
-}
-
 /// Every placed piece of the first simulated wall within 2 mm and 1° of its target.
 fn assert_placed_within_2_mm_and_1_degree(sim: &Simulation, context: &str) {
     for p in &sim.records[0].placements {
@@ -314,7 +308,7 @@ fn nailing_does_not_shift_the_placed_frame() {
 fn two_runs_give_byte_identical_json() {
     let (_, a) = run("tm1.ifc", "study-abb", &[]);
     let (_, b) = run("tm1.ifc", "study-abb", &[]);
-    assert_eq!(json(&a), json(&b));
+    assert_eq!(a.to_json(), b.to_json());
 }
 
 #[test]

@@ -31,12 +31,6 @@ fn run(cell: &Cell) -> (Simulation, SimReport) {
     (sim, report)
 }
 
-fn json(report: &SimReport) -> String {
-    let mut out = Vec::new();
-    report.write_json(&mut out).unwrap();
-    String::from_utf8(out).unwrap()
-}
-
 /// A table raised to 0.8..1.6 m beside the robot, where the arm swings from the pick belt
 /// behind it to the wall in front of it.
 fn raised_table() -> Cell {
@@ -64,7 +58,7 @@ fn a_raised_tool_table_on_the_way_is_gone_around_without_a_contact() {
 #[test]
 fn planned_paths_are_deterministic() {
     let cell = raised_table();
-    assert_eq!(json(&run(&cell).1), json(&run(&cell).1));
+    assert_eq!(run(&cell).1.to_json(), run(&cell).1.to_json());
 }
 
 #[test]

@@ -322,6 +322,14 @@ impl SimReport {
         }
     }
 
+    /// The JSON document as a string (what `write_json` writes).
+    pub fn to_json(&self) -> String {
+        let mut out = Vec::new();
+        self.write_json(&mut out)
+            .expect("writing to memory does not fail");
+        String::from_utf8(out).expect("serde_json writes UTF-8")
+    }
+
     pub fn write_json(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
         serde_json::to_writer_pretty(&mut *out, self)?;
         writeln!(out)
