@@ -110,6 +110,7 @@ fn main() {
         &path,
         &SearchOptions {
             share_equal_poses: false,
+            every_offset: true,
         },
         "own   ",
     );

@@ -15,6 +15,7 @@ fn plan_json(model: &Model, cell: &Cell, share: bool) -> Vec<u8> {
     facts.extend(cell_facts(cell));
     let options = SearchOptions {
         share_equal_poses: share,
+        ..SearchOptions::default()
     };
     add_placement_facts_with(&mut facts, cell, &RuleEngine::Compiled, &options).expect("search");
     let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");

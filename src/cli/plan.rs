@@ -4,7 +4,7 @@
 use super::check::{ReasoningInputs, load_inputs, rule_base};
 use super::{CmdResult, print_stdout, write_stdout};
 use framewright::frame::plan::Plan;
-use framewright::frame::reason;
+use framewright::frame::reason_selected;
 use framewright::report::plan::PlanReport;
 use std::path::PathBuf;
 
@@ -22,7 +22,7 @@ pub struct PlanArgs {
 pub fn run(args: PlanArgs) -> CmdResult {
     let inputs = &args.inputs;
     let (model, _, facts) = load_inputs(&args.model, inputs)?;
-    let reasoned = reason(&facts, &rule_base(&inputs.rules_dir), false)?;
+    let reasoned = reason_selected(&facts, &rule_base(&inputs.rules_dir), Plan::RELATIONS)?;
     let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
     if args.json {
         write_stdout(|out| report.write_json(&mut &mut *out))

@@ -4,6 +4,7 @@
 
 pub mod cell_facts;
 pub mod facts;
+pub mod limits;
 pub mod placement;
 pub mod plan;
 
@@ -14,6 +15,7 @@ use std::sync::Arc;
 
 pub use cell_facts::cell_facts;
 pub use facts::{Facts, model_facts};
+pub use limits::RuleLimits;
 
 #[derive(Debug, thiserror::Error)]
 pub enum FrameError {
@@ -25,6 +27,8 @@ pub enum FrameError {
     Compiled(String),
     #[error("{}: cannot read the rules directory: {message}", path.display())]
     RulesDir { path: PathBuf, message: String },
+    #[error(transparent)]
+    Limit(#[from] limits::LimitError),
 }
 
 /// Which engine evaluates the rule base.
@@ -85,10 +89,50 @@ pub fn reason(
     engine: &RuleEngine,
     provenance: bool,
 ) -> Result<Reasoned, FrameError> {
+    reason_within(facts, engine, provenance, None, &RuleLimits::from_env()?)
+}
+
+/// Runs the rule base over the facts for a caller that reads only the named relations (the
+/// others may be missing from the result): the compiled engine then turns only those into
+/// `Value` tuples. `plan` reads `Plan::RELATIONS`.
+pub fn reason_selected(
+    facts: &Facts,
+    engine: &RuleEngine,
+    relations: &[&str],
+) -> Result<Reasoned, FrameError> {
+    reason_within(
+        facts,
+        engine,
+        false,
+        Some(relations),
+        &RuleLimits::from_env()?,
+    )
+}
+
+/// `reason` or `reason_selected` under explicit bounds.
+pub fn reason_within(
+    facts: &Facts,
+    engine: &RuleEngine,
+    provenance: bool,
+    selected: Option<&[&str]>,
+    limits: &RuleLimits,
+) -> Result<Reasoned, FrameError> {
+    let reasoned = reason_unchecked(facts, engine, provenance, selected, limits)?;
+    limits.check_walls(reasoned.get("wall").len() as u64)?;
+    Ok(reasoned)
+}
+
+fn reason_unchecked(
+    facts: &Facts,
+    engine: &RuleEngine,
+    provenance: bool,
+    selected: Option<&[&str]>,
+    limits: &RuleLimits,
+) -> Result<Reasoned, FrameError> {
     let program = match engine {
         RuleEngine::Compiled if !provenance => {
             return Ok(Reasoned {
-                relations: reason_compiled(facts)?,
+                relations: reason_compiled(facts, selected, limits)?,
                 engine: None,
             });
         }
@@ -120,19 +164,48 @@ pub fn reason(
 const SMALL_RELATION: usize = 4096;
 
 /// The compiled rule base, run on each container's facts in parallel and the
-/// results merged (same relations as one run over everything).
-fn reason_compiled(facts: &Facts) -> Result<Relations, FrameError> {
+/// results merged (same relations as one run over everything). With `selected`, only those
+/// relations come back (and `wall`, for the wall bound). The tuples every part derives count
+/// against the rule tuple bound.
+fn reason_compiled(
+    facts: &Facts,
+    selected: Option<&[&str]>,
+    limits: &RuleLimits,
+) -> Result<Relations, FrameError> {
     use rayon::prelude::*;
+    use std::sync::atomic::{AtomicU64, Ordering};
     let run = compiled::program("rules")
         .ok_or_else(|| FrameError::Compiled("no compiled rule base".into()))?;
     let mut parts = facts.by_container();
     // Largest first, so the parallel runs finish together.
     parts.sort_by_key(|p| std::cmp::Reverse(p.get("piece").map_or(0, Vec::len)));
+    let wanted: Option<Vec<&str>> = selected.map(|names| {
+        let mut v: Vec<&str> = names.to_vec();
+        v.push("wall");
+        v
+    });
+    let total = AtomicU64::new(0);
     let results: Vec<Relations> = parts
-        .par_iter()
-        .map(run)
-        .collect::<Result<_, String>>()
-        .map_err(FrameError::Compiled)?;
+        .into_par_iter()
+        .map(|part| -> Result<Relations, FrameError> {
+            let (relations, tuples) = match &wanted {
+                Some(w) if compiled::builtin::handles(&part, w) => {
+                    let r =
+                        compiled::builtin::run_selected(&part, w).map_err(FrameError::Compiled)?;
+                    (r.relations, r.tuples)
+                }
+                _ => {
+                    let r = run(&part).map_err(FrameError::Compiled)?;
+                    let n = r.values().map(|t| t.len() as u64).sum();
+                    (r, n)
+                }
+            };
+            drop(part);
+            let sum = total.fetch_add(tuples, Ordering::Relaxed) + tuples;
+            limits.check_tuples(sum)?;
+            Ok(relations)
+        })
+        .collect::<Result<_, FrameError>>()?;
     // Parts are in a fixed order and each part's tuples come sorted, so the
     // concatenation is deterministic. Relations keyed by a piece, wall or
     // storey cannot share tuples between parts; only the small relations

@@ -11,7 +11,7 @@
 //! solve, at one of the rolls the executor tries. Every solution counted keeps the arm and
 //! its tool above the floor.
 
-use super::{Facts, FrameError, Reasoned, RuleEngine, reason};
+use super::{Facts, FrameError, Reasoned, RuleEngine, reason_selected};
 use crate::cell::tcp_poses::{centre_grip, lowest_point, nail_pose, nail_rolls, retreat};
 use crate::cell::{Cell, OffsetX};
 use crate::logic::{Origin, Value};
@@ -38,12 +38,18 @@ pub struct SearchOptions {
     /// Targets whose poses agree to SHARE_GRID run the search once (repeated walls of a
     /// big model are searched once); off, every target runs its own search.
     pub share_equal_poses: bool,
+    /// Every tried offset becomes a `placement_candidate` of every wall; off (the default),
+    /// only the offsets where a wall's count can rise: the first, and the start of each run
+    /// of its pieces and nails. The most reached, nearest the base, is always among them, so
+    /// the chosen offset is the same, and the rules count far fewer (wall, offset) pairs.
+    pub every_offset: bool,
 }
 
 impl Default for SearchOptions {
     fn default() -> Self {
         SearchOptions {
             share_equal_poses: true,
+            every_offset: false,
         }
     }
 }
@@ -72,10 +78,18 @@ pub fn add_placement_facts_with(
     let OffsetX::Auto { min, max } = cell.assembly.offset_x else {
         return Ok(());
     };
-    let first = reason(facts, engine, false)?;
+    let first = reason_selected(facts, engine, FIRST_PASS)?;
     facts.extend(placement_facts_with(cell, &first, min, max, options));
     Ok(())
 }
+
+/// What the search reads of the first pass.
+const FIRST_PASS: &[&str] = &[
+    "piece_size",
+    "wall_of",
+    "placement_target_at_zero",
+    "placement_nail_at_zero",
+];
 
 /// The offsets tried: `min` to `max` every OFFSET_STEP, in whole millimetres.
 pub fn candidate_offsets(min: f64, max: f64) -> Vec<f64> {
@@ -85,7 +99,8 @@ pub fn candidate_offsets(min: f64, max: f64) -> Vec<f64> {
         .collect()
 }
 
-/// `placement_candidate(w, x)` for every wall and offset, `placement_reaches(p, from, to)` for
+/// `placement_candidate(w, x)` for every wall and each offset where its count can rise
+/// (every offset with `SearchOptions::every_offset`), `placement_reaches(p, from, to)` for
 /// every run of offsets at which the arm reaches a piece, `placement_nail_reaches(…, from, to)`
 /// the same for nails.
 pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Facts {
@@ -169,11 +184,18 @@ pub fn placement_facts_with(
     );
 
     let mut facts = Facts::default();
-    let mut wall_names: Vec<&str> = walls.values().copied().collect();
-    wall_names.sort_unstable();
-    wall_names.dedup();
-    for w in wall_names {
-        for &x in &offsets {
+    let candidates = wall_candidates(
+        &offsets,
+        &walls,
+        pieces.iter().map(|(p, _, _)| *p).zip(&reached),
+        nails
+            .iter()
+            .filter_map(|(key, _, _)| key.first()?.as_symbol())
+            .zip(&nails_reached),
+        options.every_offset,
+    );
+    for (w, xs) in candidates {
+        for x in xs {
             facts.add(
                 "placement_candidate",
                 vec![Value::sym(w), Value::float(x)],
@@ -207,6 +229,35 @@ pub fn placement_facts_with(
         }
     }
     facts
+}
+
+/// The offsets tried for each wall (walls sorted by name, offsets ascending). The count of
+/// a wall at x (its pieces and nails reached) only rises at the first offset or where a run
+/// starts, so the smallest x with the largest count is one of those: with `every` false only
+/// they are candidates.
+fn wall_candidates<'a>(
+    offsets: &[f64],
+    walls: &BTreeMap<&'a str, &'a str>,
+    pieces: impl Iterator<Item = (&'a str, &'a Vec<(f64, f64)>)>,
+    nails: impl Iterator<Item = (&'a str, &'a Vec<(f64, f64)>)>,
+    every: bool,
+) -> BTreeMap<&'a str, Vec<f64>> {
+    let mut starts: BTreeMap<&str, Vec<f64>> = walls.values().map(|w| (*w, Vec::new())).collect();
+    if every {
+        starts.values_mut().for_each(|xs| xs.extend(offsets));
+        return starts;
+    }
+    for (piece, runs) in pieces.chain(nails) {
+        if let Some(xs) = walls.get(piece).and_then(|w| starts.get_mut(w)) {
+            xs.extend(runs.iter().map(|(from, _)| *from));
+        }
+    }
+    for xs in starts.values_mut() {
+        xs.extend(offsets.first());
+        xs.sort_by(f64::total_cmp);
+        xs.dedup();
+    }
+    starts
 }
 
 /// `search` for every item, in parallel; with `share`, items of one key run it once (the

@@ -3,6 +3,7 @@
 //! `benches/logic/*.dl` (listed by path) into an `ascent!` program with a
 //! wrapper `run(&edb) -> relations` on `Value` tuples.
 
+pub mod builtin;
 pub mod rt;
 
 use crate::logic::value::Value;
