@@ -397,6 +397,51 @@ mod tests {
         assert!(robustly(&offsets, &none).is_empty());
     }
 
+    /// The offset the rules choose (most reached, nearest the base) over some candidates.
+    fn choice(xs: &[f64], runs: &[Vec<(f64, f64)>]) -> f64 {
+        let count = |x: f64| {
+            runs.iter()
+                .flatten()
+                .filter(|(lo, hi)| *lo <= x && x <= *hi)
+                .count()
+        };
+        let best = xs.iter().map(|x| count(*x)).max().unwrap();
+        *xs.iter().find(|x| count(**x) == best).unwrap()
+    }
+
+    #[test]
+    fn the_chosen_offset_is_among_the_fewer_candidates() {
+        let offsets = candidate_offsets(0.5, 0.7);
+        let walls: BTreeMap<&str, &str> = [("a", "W"), ("b", "W"), ("c", "W"), ("d", "V")]
+            .into_iter()
+            .collect();
+        // Pieces a, b, c of W and d of V, reached over runs of the tried offsets.
+        let runs = [
+            vec![(0.52, 0.6), (0.65, 0.7)],
+            vec![(0.55, 0.62)],
+            vec![(0.58, 0.66)],
+            vec![],
+        ];
+        let names = ["a", "b", "c", "d"];
+        for every in [false, true] {
+            let c = wall_candidates(
+                &offsets,
+                &walls,
+                names.into_iter().zip(&runs),
+                std::iter::empty(),
+                every,
+            );
+            let w = &c["W"];
+            if !every {
+                assert_eq!(w, &vec![0.5, 0.52, 0.55, 0.58, 0.65]);
+                // A wall nothing reaches keeps the first offset (where the rules put it).
+                assert_eq!(c["V"], vec![0.5]);
+            }
+            assert_eq!(choice(w, &runs[..3]), choice(&offsets, &runs[..3]));
+        }
+        assert_eq!(choice(&offsets, &runs[..3]), 0.58);
+    }
+
     #[test]
     fn offsets_cover_the_range_in_whole_millimetres() {
         let xs = candidate_offsets(0.5, 0.55);
