@@ -81,6 +81,34 @@ fn groundedness() {
     );
 }
 
+// Found by fuzzing: a `_` inside an expression passed the checker and reached the
+// interpreter, which has no value for it. Soufflé rejects these too ("Underscore in
+// head of rule", "Underscore in binary relation"); a `_` as a whole atom argument stays.
+#[test]
+fn wildcards_stand_only_for_whole_atom_arguments() {
+    let what = "`_` inside an expression";
+    fails("p(_ + 1, y) :- e(_, y).\n", 4, 3, what);
+    fails("p(x, y) :- e(x, y), x % 2 = _.\n", 4, 29, what);
+    fails("p(x, y) :- e(x, y), y = _ + 1.\n", 4, 25, what);
+    fails("p(x, y) :- e(x, y), e(_ - 1, x).\n", 4, 23, what);
+    fails("s(n) :- s(n), match(\"a.*\", _).\n", 4, 28, what);
+    fails("s(n) :- s(n), !contains(_, n).\n", 4, 25, what);
+    fails("p(1, _ + 2).\n", 4, 6, what);
+    fails(
+        "p(x, m) :- e(x, _), m = min _ + y : { e(a, y), a != x }.\n",
+        4,
+        29,
+        what,
+    );
+    fails("s(to_string(_)) :- e(_, _).\n", 4, 13, what);
+    // Whole arguments of body atoms, negated atoms and aggregate bodies still read.
+    Program::parse_str(
+        "w.dl",
+        &format!("{DECLS}p(x, y) :- e(x, _), e(_, y), !e(y, _), y = count : {{ e(_, x) }}.\n"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+}
+
 #[test]
 fn negation_and_aggregation_cycles_name_the_cycle() {
     let s = fails(
