@@ -74,8 +74,9 @@ impl Default for Limits {
         Limits {
             max_tuples: 50_000_000,
             max_iterations: 100_000,
-            // Some minutes of joining on one core; far above any rule set framewright ships.
-            max_steps: 20_000_000_000,
+            // About 3 minutes of joining on one core (10^7 visits/s measured); far above
+            // any rule set framewright ships.
+            max_steps: 2_000_000_000,
         }
     }
 }
