@@ -131,6 +131,7 @@ fn a_rule_file_that_runs_away_stops_at_the_limit() {
         .with_limits(Limits {
             max_tuples: 10_000,
             max_iterations: 1_000,
+            ..Limits::default()
         });
     let mut relations = framewright::logic::compiled::Relations::new();
     relations.insert(

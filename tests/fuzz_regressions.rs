@@ -152,3 +152,54 @@ fn deeply_nested_urdf_is_refused_before_parsing() {
         "{message}"
     );
 }
+
+/// The error a program gets under the fuzz targets' limits, on a thread bounded by `HANG`.
+fn stopped_under_run_limits(text: &'static str) -> String {
+    use framewright::logic::{Engine, Options};
+    let (done, finished) = mpsc::channel();
+    std::thread::spawn(move || {
+        let program = std::sync::Arc::new(Program::parse_str("runaway.dl", text).unwrap());
+        let mut engine = Engine::new(
+            program,
+            Options {
+                provenance: true,
+                limits: targets::RUN_LIMITS,
+            },
+        );
+        let _ = done.send(engine.run().map(|_| ()).map_err(|e| e.to_string()));
+    });
+    match finished.recv_timeout(HANG) {
+        Ok(Err(message)) => message,
+        Ok(Ok(())) => panic!("{text}: ran to its end under the limits"),
+        Err(e) => panic!("{text}: {e:?} after {HANG:?}"),
+    }
+}
+
+// Shapes that kept the interpreter busy far past the fuzzer's second (or its memory) while
+// the tuple and iteration limits held: each now stops at a limit that names it.
+#[test]
+fn runaway_shapes_stop_at_a_limit_under_the_fuzz_bounds() {
+    let numbers = ".decl a(x: number)\na(0).\na(x + 1) :- a(x), x < 149.\n";
+    for (rest, says) in [
+        // Work without output: 150^3 visits for 150 tuples.
+        (
+            ".decl c(x: number)\nc(x) :- a(x), a(y), a(z), y != z.\n",
+            "body tuples visited",
+        ),
+        // 22,500 new tuples in one evaluation of one rule.
+        (
+            ".decl b(x: number, y: number)\nb(x, y) :- a(x), a(y).\n",
+            "more than 20000 tuples",
+        ),
+        // A string doubling every iteration.
+        (
+            ".decl s(x: symbol)\ns(\"ab\").\ns(cat(x, x)) :- s(x).\n",
+            "more than the limit of 1048576 bytes",
+        ),
+    ] {
+        let text: &'static str = format!("{numbers}{rest}").leak();
+        let message = stopped_under_run_limits(text);
+        assert!(message.contains(says), "{text}\n{message}");
+        assert!(message.contains("runaway.dl:"), "names the rule: {message}");
+    }
+}

@@ -81,6 +81,34 @@ fn groundedness() {
     );
 }
 
+// Found by fuzzing: a `_` inside an expression passed the checker and reached the
+// interpreter, which has no value for it. Soufflé rejects these too ("Underscore in
+// head of rule", "Underscore in binary relation"); a `_` as a whole atom argument stays.
+#[test]
+fn wildcards_stand_only_for_whole_atom_arguments() {
+    let what = "`_` inside an expression";
+    fails("p(_ + 1, y) :- e(_, y).\n", 4, 3, what);
+    fails("p(x, y) :- e(x, y), x % 2 = _.\n", 4, 29, what);
+    fails("p(x, y) :- e(x, y), y = _ + 1.\n", 4, 25, what);
+    fails("p(x, y) :- e(x, y), e(_ - 1, x).\n", 4, 23, what);
+    fails("s(n) :- s(n), match(\"a.*\", _).\n", 4, 28, what);
+    fails("s(n) :- s(n), !contains(_, n).\n", 4, 25, what);
+    fails("p(1, _ + 2).\n", 4, 6, what);
+    fails(
+        "p(x, m) :- e(x, _), m = min _ + y : { e(a, y), a != x }.\n",
+        4,
+        29,
+        what,
+    );
+    fails("s(to_string(_)) :- e(_, _).\n", 4, 13, what);
+    // Whole arguments of body atoms, negated atoms and aggregate bodies still read.
+    Program::parse_str(
+        "w.dl",
+        &format!("{DECLS}p(x, y) :- e(x, _), e(_, y), !e(y, _), y = count : {{ e(_, x) }}.\n"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+}
+
 #[test]
 fn negation_and_aggregation_cycles_name_the_cycle() {
     let s = fails(
@@ -238,6 +266,7 @@ fn unbounded_value_creation_is_stopped_by_the_limits() {
         Limits {
             max_tuples: 1_000_000,
             max_iterations: 500,
+            ..Limits::default()
         },
     );
     let s = err.to_string();
@@ -251,7 +280,79 @@ fn unbounded_value_creation_is_stopped_by_the_limits() {
         Limits {
             max_tuples: 300,
             max_iterations: 100_000,
+            ..Limits::default()
         },
     );
     assert!(err.to_string().contains("more than 300 tuples"), "{err}");
+}
+
+fn limits(max_tuples: usize, max_steps: u64) -> Limits {
+    Limits {
+        max_tuples,
+        max_steps,
+        ..Limits::default()
+    }
+}
+
+/// 300 numbers, then a rule over their pairs or triples.
+fn product_program(rule: &str) -> String {
+    format!(
+        ".decl a(x: number)\na(0).\na(x + 1) :- a(x), x < 299.\n.decl b(x: number, y: number)\n.decl c(x: number)\n// @rule product\n{rule}\n"
+    )
+}
+
+// A join that derives 300 tuples from 300^3 body combinations: only the work bound stops it.
+#[test]
+fn a_join_that_works_without_deriving_is_stopped_by_the_step_limit() {
+    let prog = product_program("c(x) :- a(x), a(y), a(z), y != z.");
+    let err = run_err(&prog, limits(1_000_000, 1_000_000));
+    let s = err.to_string();
+    assert!(matches!(err, LogicError::Limit { .. }), "{s}");
+    assert!(
+        s.contains("more than 1000000 body tuples visited")
+            && s.contains("product (rt.dl:7)")
+            && s.contains("--max-steps"),
+        "{s}"
+    );
+    // The same join with room to finish: 300 + 300^2 + 300^3 visits.
+    let p = Arc::new(Program::parse_str("rt.dl", &prog).unwrap());
+    let mut e = Engine::new(
+        p,
+        Options {
+            provenance: false,
+            limits: limits(1_000_000, 28_000_000),
+        },
+    );
+    e.run().unwrap();
+    assert_eq!(e.len("c").unwrap(), 300);
+}
+
+// 90,000 new pairs in one evaluation of one rule: stopped as they pass the limit, not after.
+#[test]
+fn the_tuple_limit_stops_a_rule_in_the_middle_of_its_evaluation() {
+    let err = run_err(
+        &product_program("b(x, y) :- a(x), a(y)."),
+        limits(1_000, u64::MAX),
+    );
+    let s = err.to_string();
+    assert!(
+        s.contains("more than 1000 tuples") && s.contains("product (rt.dl:7)"),
+        "{s}"
+    );
+}
+
+// A string that doubles every iteration needs 2^k bytes: refused past 1 MiB, with the
+// bindings in the message cut to a readable length.
+#[test]
+fn a_runaway_concatenation_stops_at_the_symbol_limit() {
+    let err = run_err(
+        ".decl s(x: symbol)\ns(\"ab\").\n// @rule grow\ns(cat(x, x)) :- s(x).\n",
+        Limits::default(),
+    );
+    let s = err.to_string();
+    assert!(
+        s.contains("grow (rt.dl:4)") && s.contains("more than the limit of 1048576 bytes"),
+        "{s}"
+    );
+    assert!(s.len() < 2_000, "{} bytes: {}", s.len(), &s[..2_000]);
 }

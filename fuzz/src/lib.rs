@@ -39,6 +39,7 @@ pub fn rules_front(data: &[u8]) {
 pub const RUN_LIMITS: Limits = Limits {
     max_tuples: 20_000,
     max_iterations: 200,
+    max_steps: 2_000_000,
 };
 
 /// The interpreter on a checked program (with provenance, as `why` runs it).

@@ -28,6 +28,9 @@ pub enum RulesCommand {
         /// Stop when a recursive stratum needs more iterations than this.
         #[arg(long, default_value_t = Limits::default().max_iterations)]
         max_iterations: usize,
+        /// Stop when the joins of the run have visited more body tuples than this.
+        #[arg(long, default_value_t = Limits::default().max_steps)]
+        max_steps: u64,
     },
     /// Check a rule program without running it.
     Check {
@@ -66,6 +69,7 @@ pub fn run(cmd: RulesCommand) -> CmdResult {
             rules_dir,
             max_tuples,
             max_iterations,
+            max_steps,
         } => {
             let p = std::sync::Arc::new(Program::parse_files_within(
                 &[&program],
@@ -85,6 +89,7 @@ pub fn run(cmd: RulesCommand) -> CmdResult {
                 limits: Limits {
                     max_tuples,
                     max_iterations,
+                    max_steps,
                 },
             };
             let mut engine = Engine::new(p, options);

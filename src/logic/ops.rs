@@ -56,6 +56,21 @@ pub fn rem_u64(a: u64, b: u64) -> OpResult<u64> {
     Ok(a % b)
 }
 
+/// The longest symbol `cat` may build in the interpreter: a rule that concatenates its own
+/// output doubles a string per iteration and would exhaust memory long before other limits.
+pub const MAX_SYMBOL_BYTES: usize = 1 << 20;
+
+/// `cat`, refusing results over `MAX_SYMBOL_BYTES`.
+pub fn cat_bounded(parts: &[&str]) -> OpResult<Sym> {
+    let len: usize = parts.iter().map(|p| p.len()).sum();
+    if len > MAX_SYMBOL_BYTES {
+        return Err(format!(
+            "cat would make a symbol of {len} bytes, more than the limit of {MAX_SYMBOL_BYTES} bytes \
+             (a rule that concatenates its own output grows without end: bound it, e.g. `strlen(s) < 100`)"
+        ));
+    }
+    Ok(cat(parts))
+}
 pub fn cat(parts: &[&str]) -> Sym {
     Arc::from(parts.concat().as_str())
 }
@@ -76,15 +91,47 @@ pub fn substr(s: &str, start: i64, len: i64) -> OpResult<Sym> {
         .map(Arc::from)
         .ok_or_else(|| format!("substr({s:?}, {start}, {len}) would split a UTF-8 character"))
 }
-/// A process-wide ordinal per distinct symbol (first use gets the next number).
+/// Ordinals handed out by `ord`, in order of first use.
+pub type OrdTable = HashMap<String, i64>;
+
+thread_local! {
+    /// The ordinals of the interpreter run under way on this thread (see `with_ords`).
+    static RUN_ORDS: RefCell<Option<OrdTable>> = const { RefCell::new(None) };
+}
+
+/// Run `f` with `table` as the ordinals `ord` hands out on this thread, so a run's
+/// ordinals depend on that run only, not on what else ran in the process before.
+pub fn with_ords<R>(table: &RefCell<OrdTable>, f: impl FnOnce() -> R) -> R {
+    /// Puts the table back into its owner even when `f` unwinds.
+    struct Restore<'t>(&'t RefCell<OrdTable>, Option<OrdTable>);
+    impl Drop for Restore<'_> {
+        fn drop(&mut self) {
+            let used = RUN_ORDS.with(|r| std::mem::replace(&mut *r.borrow_mut(), self.1.take()));
+            *self.0.borrow_mut() = used.unwrap_or_default();
+        }
+    }
+    let mine = std::mem::take(&mut *table.borrow_mut());
+    let outer = RUN_ORDS.with(|r| r.borrow_mut().replace(mine));
+    let _restore = Restore(table, outer);
+    f()
+}
+
+/// An ordinal per distinct symbol (first use gets the next number): per interpreter run
+/// inside `with_ords`, else process-wide (the compiled path).
 pub fn ord(s: &str) -> i64 {
-    static TABLE: OnceLock<Mutex<HashMap<String, i64>>> = OnceLock::new();
+    let next = |t: &mut OrdTable| {
+        let n = t.len() as i64;
+        *t.entry(s.to_string()).or_insert(n)
+    };
+    if let Some(n) = RUN_ORDS.with(|r| r.borrow_mut().as_mut().map(next)) {
+        return n;
+    }
+    static TABLE: OnceLock<Mutex<OrdTable>> = OnceLock::new();
     let mut t = TABLE
         .get_or_init(Default::default)
         .lock()
         .unwrap_or_else(|e| e.into_inner());
-    let n = t.len() as i64;
-    *t.entry(s.to_string()).or_insert(n)
+    next(&mut t)
 }
 pub fn to_number(s: &str) -> OpResult<i64> {
     s.trim()
@@ -130,26 +177,29 @@ pub fn take_warnings() -> Vec<String> {
 /// a warning, as Soufflé documents ("wrong pattern provided for match").
 pub fn regex_match(pattern: &str, text: &str) -> OpResult<bool> {
     thread_local! {
-        static CACHE: RefCell<HashMap<String, Option<regex::Regex>>> = RefCell::new(HashMap::new());
+        /// Compiled patterns, or why one is not a regular expression. Only a cache: the
+        /// warning is recorded on every use, so a run warns whatever ran before it.
+        static CACHE: RefCell<HashMap<String, Result<regex::Regex, String>>> = RefCell::new(HashMap::new());
     }
     CACHE.with(|c| {
         let mut c = c.borrow_mut();
         if !c.contains_key(pattern) {
-            let re = regex::Regex::new(&format!("^(?:{pattern})$"));
-            if let Err(e) = &re {
+            let re = regex::Regex::new(&format!("^(?:{pattern})$")).map_err(|e| {
                 let first = e.to_string().lines().last().unwrap_or_default().to_string();
-                WARNINGS.with(|w| {
-                    w.borrow_mut().insert(format!(
-                        "wrong pattern provided for match({pattern:?}, ...): {first}; it matches nothing"
-                    ))
-                });
-            }
+                format!("wrong pattern provided for match({pattern:?}, ...): {first}; it matches nothing")
+            });
             if c.len() > 1024 {
                 c.clear();
             }
-            c.insert(pattern.to_string(), re.ok());
+            c.insert(pattern.to_string(), re);
         }
-        Ok(c[pattern].as_ref().is_some_and(|re| re.is_match(text)))
+        match &c[pattern] {
+            Ok(re) => Ok(re.is_match(text)),
+            Err(warning) => {
+                WARNINGS.with(|w| w.borrow_mut().insert(warning.clone()));
+                Ok(false)
+            }
+        }
     })
 }
 

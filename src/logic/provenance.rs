@@ -111,7 +111,7 @@ impl Engine {
             )));
         };
         let mut budget = MAX_NODES;
-        Ok(self.explain_id(r, id, &mut budget))
+        Ok(self.with_ords(|| self.explain_id(r, id, &mut budget)))
     }
 
     fn explain_id(&self, r: usize, id: u32, budget: &mut usize) -> Explanation {
@@ -199,6 +199,11 @@ impl Engine {
 
     /// Why a tuple is not derived: per candidate rule, the first failing literal.
     pub fn explain_not(&self, rel: &str, tuple: &[Value]) -> Result<WhyNot, LogicError> {
+        // Rule expressions are evaluated again: with the `ord` values of the run.
+        self.with_ords(|| self.why_not(rel, tuple))
+    }
+
+    fn why_not(&self, rel: &str, tuple: &[Value]) -> Result<WhyNot, LogicError> {
         let r = self.rel_id(rel)?;
         self.check_tuple(r, tuple)?;
         if self.rels[r].find(tuple).is_some() {

@@ -961,17 +961,17 @@ impl Checker<'_> {
                     return None;
                 }
             },
-            ExprKind::Wild => match expected {
-                Some(t) => t,
-                None => {
-                    self.error(
-                        span,
-                        "`_` is only allowed as an atom argument",
-                        "use a named variable",
-                    );
-                    return None;
-                }
-            },
+            // A whole argument of a body atom never gets here (`check_lits` types it);
+            // anywhere else `_` would be a value nothing binds, as Soufflé rejects it
+            // ("Underscore in binary relation", "Underscore in head of rule").
+            ExprKind::Wild => {
+                self.error(
+                    span,
+                    "`_` inside an expression, comparison or aggregated value",
+                    "`_` stands only for a whole argument of a body atom, as in `a(x, _)`; use a named variable here",
+                );
+                return None;
+            }
             ExprKind::Int(i) => {
                 let t = expected.unwrap_or(BaseTy::Number);
                 let ok = match t {
@@ -1173,7 +1173,11 @@ impl Checker<'_> {
                 Literal::Pos(a) | Literal::Neg(a) => {
                     let tys = self.atom_types.get(&a.rel).cloned().unwrap_or_default();
                     for (e, t) in a.args.iter_mut().zip(tys) {
-                        self.check_expr(e, Some(t), env);
+                        if let ExprKind::Wild = e.kind {
+                            e.ty = Some(t);
+                        } else {
+                            self.check_expr(e, Some(t), env);
+                        }
                     }
                 }
                 Literal::Cmp(op, a, b, span) => {

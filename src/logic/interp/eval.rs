@@ -98,7 +98,7 @@ fn builtin(b: Builtin, ty: BaseTy, v: Vec<Value>) -> Result<Value, String> {
         }
         Builtin::Cat => {
             let parts: Vec<&str> = v.iter().map(sym).collect();
-            Value::Symbol(ops::cat(&parts))
+            Value::Symbol(ops::cat_bounded(&parts)?)
         }
         Builtin::Strlen => Value::Number(ops::strlen(sym(&v[0]))),
         Builtin::Substr => Value::Symbol(ops::substr(

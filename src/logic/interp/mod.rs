@@ -64,6 +64,9 @@ pub struct Limits {
     pub max_tuples: usize,
     /// Semi-naive iterations per stratum.
     pub max_iterations: usize,
+    /// Body tuples visited over the whole run: the work of joins, which can be huge for
+    /// few derived tuples (`r(1) :- a(x), a(y), a(z).`).
+    pub max_steps: u64,
 }
 
 impl Default for Limits {
@@ -71,6 +74,9 @@ impl Default for Limits {
         Limits {
             max_tuples: 50_000_000,
             max_iterations: 100_000,
+            // About 3 minutes of joining on one core (10^7 visits/s measured); far above
+            // any rule set framewright ships.
+            max_steps: 2_000_000_000,
         }
     }
 }
@@ -98,6 +104,17 @@ pub struct Engine {
     strata: Vec<Vec<CRule>>,
     options: Options,
     ran: bool,
+    /// What `ord` handed out in this engine's run (explanations evaluate with the same).
+    ords: std::cell::RefCell<super::ops::OrdTable>,
+    /// Body tuples the run may still visit (`Limits::max_steps`).
+    steps_left: std::cell::Cell<u64>,
+}
+
+/// Why an evaluation stopped before its end: a limit, reported as `LogicError::Limit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Stop {
+    Steps,
+    Tuples,
 }
 
 type Cont<'k> = dyn FnMut(&mut Exec<'_>, &mut Vec<Value>) -> Result<(), String> + 'k;
@@ -107,6 +124,10 @@ pub(crate) struct Exec<'a> {
     /// Per relation: (end of old tuples, end of tuples visible this iteration).
     lim: &'a [(u32, u32)],
     pub(crate) trail: Vec<(u32, u32)>,
+    /// Body tuples this evaluation may still visit.
+    budget: u64,
+    /// Set when a limit stopped the evaluation (its error string is then only a marker).
+    stop: Option<Stop>,
 }
 
 impl Engine {
@@ -137,11 +158,18 @@ impl Engine {
             strata,
             options,
             ran: false,
+            ords: Default::default(),
+            steps_left: std::cell::Cell::new(options.limits.max_steps),
         }
     }
 
     pub fn program(&self) -> &Program {
         &self.program
+    }
+
+    /// Run `f` with this engine's `ord` table (explanations re-evaluate rule expressions).
+    pub(crate) fn with_ords<R>(&self, f: impl FnOnce() -> R) -> R {
+        super::ops::with_ords(&self.ords, f)
     }
 
     pub(crate) fn rel_id(&self, name: &str) -> Result<usize, LogicError> {
@@ -211,16 +239,21 @@ impl Engine {
         }
         self.ran = true;
         let mut stats = RunStats::default();
-        let _ = super::ops::take_warnings();
         let strata = std::mem::take(&mut self.strata);
-        let result = (|| -> Result<(), LogicError> {
-            for (si, rules) in strata.iter().enumerate() {
-                self.run_stratum(si, rules, &mut stats)?;
-            }
-            Ok(())
-        })();
+        let ords = std::mem::take(&mut self.ords);
+        let result = super::ops::with_ords(&ords, || {
+            let _ = super::ops::take_warnings();
+            let result = (|| -> Result<(), LogicError> {
+                for (si, rules) in strata.iter().enumerate() {
+                    self.run_stratum(si, rules, &mut stats)?;
+                }
+                Ok(())
+            })();
+            stats.warnings = super::ops::take_warnings();
+            result
+        });
+        self.ords = ords;
         self.strata = strata;
-        stats.warnings = super::ops::take_warnings();
         result?;
         stats.tuples = self.rels.iter().map(Relation::len).sum();
         Ok(stats)
@@ -250,7 +283,7 @@ impl Engine {
                 let mut target = std::mem::replace(&mut self.rels[head], Relation::new(0));
                 let mut target_prov = self.prov.as_mut().map(|p| std::mem::take(&mut p[head]));
                 let result = rules.iter().try_for_each(|rule| {
-                    self.eval_rule_into(rule, &lim, &mut target, target_prov.as_mut())
+                    self.eval_rule_into(si, rule, &lim, &mut target, target_prov.as_mut())
                 });
                 self.rels[head] = target;
                 if let (Some(p), Some(tp)) = (&mut self.prov, target_prov) {
@@ -264,7 +297,7 @@ impl Engine {
                 if iteration > 0 && !rule.recursive {
                     continue;
                 }
-                let (pending, provs) = self.eval_rule(rule, &lim)?;
+                let (pending, provs) = self.eval_rule(si, iteration, rule, &lim)?;
                 if !pending.is_empty() {
                     produced.push((rule.id, pending, provs));
                 }
@@ -333,8 +366,13 @@ impl Engine {
     ) -> Result<(), LogicError> {
         let total: usize = self.rels.iter().map(Relation::len).sum();
         if total > self.options.limits.max_tuples {
-            let rule = best.unwrap_or(rules[0].id);
-            return Err(LogicError::Limit {
+            return Err(self.tuple_limit_error(si, best.unwrap_or(rules[0].id), iteration));
+        }
+        Ok(())
+    }
+
+    fn tuple_limit_error(&self, si: usize, rule: usize, iteration: usize) -> LogicError {
+        LogicError::Limit {
                 message: format!(
                     "more than {} tuples (limit) after {} iteration(s) of the stratum of {}; rule {} `{}` keeps adding tuples",
                     self.options.limits.max_tuples,
@@ -344,27 +382,71 @@ impl Engine {
                     self.program.rules[rule]
                 ),
                 hint: "a rule that computes new values from its own output (e.g. `n(x+1) :- n(x).`) never stops; bound it with a condition such as `x < 100`, or raise the limit (--max-tuples)".into(),
-            });
         }
-        Ok(())
+    }
+
+    /// The error for a limit that stopped rule `rule` in the middle of an iteration.
+    fn stop_error(&self, stop: Stop, si: usize, rule: usize, iteration: usize) -> LogicError {
+        match stop {
+            Stop::Tuples => self.tuple_limit_error(si, rule, iteration),
+            Stop::Steps => LogicError::Limit {
+                message: format!(
+                    "more than {} body tuples visited (limit) in iteration {} of the stratum of {}; rule {} `{}` was joining",
+                    self.options.limits.max_steps,
+                    iteration + 1,
+                    self.stratum_names(si),
+                    self.program.rule_name(rule),
+                    self.program.rules[rule]
+                ),
+                hint: "joining relations without shared variables (e.g. `r(1) :- a(x), a(y), a(z).`) visits the product of their sizes; join on shared variables, or raise the limit (--max-steps)".into(),
+            },
+        }
+    }
+
+    /// An `Exec` over the current relations with the run's remaining step budget.
+    fn exec<'e>(&'e self, lim: &'e [(u32, u32)]) -> Exec<'e> {
+        Exec {
+            rels: &self.rels,
+            lim,
+            trail: Vec::new(),
+            budget: self.steps_left.get(),
+            stop: None,
+        }
+    }
+
+    /// Turn an evaluation's failure into the error to report, and keep its step count.
+    fn finish(
+        &self,
+        ex: &Exec<'_>,
+        result: Result<(), String>,
+        (si, iteration): (usize, usize),
+        rule: &CRule,
+        env: &[Value],
+    ) -> Result<(), LogicError> {
+        self.steps_left.set(ex.budget);
+        match (result, ex.stop) {
+            (Ok(()), _) => Ok(()),
+            (Err(_), Some(stop)) => Err(self.stop_error(stop, si, rule.id, iteration)),
+            (Err(msg), None) => Err(self.runtime_error(rule, env, msg)),
+        }
     }
 
     /// Evaluate a rule of a non-recursive stratum, inserting into its (taken out) head relation.
     fn eval_rule_into(
         &self,
+        si: usize,
         rule: &CRule,
         lim: &[(u32, u32)],
         head: &mut Relation,
         mut prov: Option<&mut Vec<Prov>>,
     ) -> Result<(), LogicError> {
         let mut env = vec![Value::Number(0); rule.slot_names.len()];
-        let mut ex = Exec {
-            rels: &self.rels,
-            lim,
-            trail: Vec::new(),
-        };
+        let mut ex = self.exec(lim);
         let mut tuple = Vec::with_capacity(head.arity);
         let all_prov = self.prov.as_ref();
+        // The head relation is taken out of `rels` while it fills.
+        let others: usize = self.rels.iter().map(Relation::len).sum();
+        let max_tuples = self.options.limits.max_tuples;
         for steps in &rule.variants {
             let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
                 tuple.clear();
@@ -372,9 +454,12 @@ impl Engine {
                     tuple.push(eval::eval(e, env)?);
                 }
                 let h = hash_values(tuple.iter());
-                if head.insert_hashed(&tuple, h).is_some()
-                    && let (Some(p), Some(all)) = (prov.as_deref_mut(), all_prov)
-                {
+                let added = head.insert_hashed(&tuple, h).is_some();
+                if added && others + head.len() > max_tuples {
+                    ex.stop = Some(Stop::Tuples);
+                    return Err(String::new());
+                }
+                if added && let (Some(p), Some(all)) = (prov.as_deref_mut(), all_prov) {
                     let height = 1 + ex
                         .trail
                         .iter()
@@ -389,8 +474,8 @@ impl Engine {
                 }
                 Ok(())
             };
-            ex.run(steps, &mut env, &mut emit)
-                .map_err(|msg| self.runtime_error(rule, &env, msg))?;
+            let result = ex.run(steps, &mut env, &mut emit);
+            self.finish(&ex, result, (si, 0), rule, &env)?;
         }
         Ok(())
     }
@@ -408,6 +493,8 @@ impl Engine {
     #[allow(clippy::type_complexity)]
     fn eval_rule(
         &self,
+        si: usize,
+        iteration: usize,
         rule: &CRule,
         lim: &[(u32, u32)],
     ) -> Result<(Relation, Vec<RecordedBody>), LogicError> {
@@ -418,12 +505,10 @@ impl Engine {
         let mut provs: Vec<RecordedBody> = Vec::new();
         let want_prov = self.prov.is_some();
         let mut env = vec![Value::Number(0); rule.slot_names.len()];
-        let mut ex = Exec {
-            rels: &self.rels,
-            lim,
-            trail: Vec::new(),
-        };
+        let mut ex = self.exec(lim);
         let mut tuple = Vec::with_capacity(head_rel.arity);
+        let stored: usize = self.rels.iter().map(Relation::len).sum();
+        let max_tuples = self.options.limits.max_tuples;
         for steps in &rule.variants {
             let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
                 tuple.clear();
@@ -433,14 +518,21 @@ impl Engine {
                 let h = hash_values(tuple.iter());
                 if head_rel.find_hashed(&tuple, h).is_none()
                     && pending.insert_hashed(&tuple, h).is_some()
-                    && want_prov
                 {
-                    provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));
+                    // New tuples of this rule alone already pass the limit: stop now
+                    // rather than after the iteration (its pending set could exhaust memory).
+                    if stored + pending.len() > max_tuples {
+                        ex.stop = Some(Stop::Tuples);
+                        return Err(String::new());
+                    }
+                    if want_prov {
+                        provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));
+                    }
                 }
                 Ok(())
             };
-            ex.run(steps, &mut env, &mut emit)
-                .map_err(|msg| self.runtime_error(rule, &env, msg))?;
+            let result = ex.run(steps, &mut env, &mut emit);
+            self.finish(&ex, result, (si, iteration), rule, &env)?;
         }
         Ok((pending, provs))
     }
@@ -451,7 +543,7 @@ impl Engine {
             .iter()
             .zip(env)
             .filter(|(n, _)| !n.starts_with("__"))
-            .map(|(n, v)| format!("{n} = {}", show(v)))
+            .map(|(n, v)| format!("{n} = {}", show_short(v)))
             .collect();
         LogicError::Runtime {
             rule: self.program.rule_name(rule.id),
@@ -514,6 +606,16 @@ fn prov_height(p: &Prov) -> u32 {
     }
 }
 
+/// `show`, cut to a readable length (a runaway `cat` can bind a megabyte).
+fn show_short(v: &Value) -> String {
+    const MAX_CHARS: usize = 200;
+    let s = show(v);
+    match s.char_indices().nth(MAX_CHARS) {
+        Some((cut, _)) => format!("{}… ({} bytes)", &s[..cut], s.len()),
+        None => s,
+    }
+}
+
 pub(crate) fn show(v: &Value) -> String {
     match v {
         Value::Symbol(s) => format!("{:?}", &**s),
@@ -527,6 +629,8 @@ impl<'a> Exec<'a> {
             rels,
             lim,
             trail: Vec::new(),
+            budget: u64::MAX,
+            stop: None,
         }
     }
 
@@ -716,6 +820,11 @@ impl<'a> Exec<'a> {
         env: &mut Vec<Value>,
         k: &mut Cont<'_>,
     ) -> Result<(), String> {
+        if self.budget == 0 {
+            self.stop = Some(Stop::Steps);
+            return Err(String::new());
+        }
+        self.budget -= 1;
         let t = r.tuple(id);
         for &(c, s) in binds {
             env[s as usize] = t[c].clone();
