@@ -68,6 +68,8 @@ pub struct WallRun<'a> {
     progress: &'a (dyn Fn(usize, usize) + Sync),
     /// Event-driven stepping's state (unused with fixed steps).
     events: stepping::Events,
+    /// The bound on the wall's simulated time (s).
+    time_limit: f64,
 }
 
 impl<'a> WallRun<'a> {
@@ -111,11 +113,20 @@ impl<'a> WallRun<'a> {
             },
             progress,
             events: stepping::Events::new(&q),
+            time_limit: f64::INFINITY,
         }
     }
 
-    /// Runs the wall: framing of every element, then nailing.
-    pub fn run(mut self, nails: &[NailPlan]) -> WallRecord {
+    /// Bounds the wall's simulated time: `run` stops with the time reached once it is past
+    /// `seconds` (checked between pieces and before nailing).
+    pub fn with_time_limit(mut self, seconds: f64) -> WallRun<'a> {
+        self.time_limit = seconds;
+        self
+    }
+
+    /// Runs the wall: framing of every element, then nailing. Err: the simulated time
+    /// reached when the run went past its time limit.
+    pub fn run(mut self, nails: &[NailPlan]) -> Result<WallRecord, f64> {
         self.load_belts();
         self.phys.drive_robot(&self.q.clone());
         self.step();
@@ -128,11 +139,14 @@ impl<'a> WallRun<'a> {
         let total = self.pieces.len();
         for (done, piece) in self.pieces.clone().into_iter().enumerate() {
             (self.progress)(done, total);
+            self.check_time()?;
             self.frame(piece);
         }
         self.record.framing_end = self.t;
+        self.check_time()?;
         self.nail_all(nails);
         self.record.nailing_end = self.t;
+        self.check_time()?;
         self.settle();
         self.measure(nails);
         self.record.trace.finish();
@@ -148,7 +162,14 @@ impl<'a> WallRun<'a> {
                 depth,
             })
             .collect();
-        self.record
+        Ok(self.record)
+    }
+
+    fn check_time(&self) -> Result<(), f64> {
+        if self.t > self.time_limit {
+            return Err(self.t);
+        }
+        Ok(())
     }
 }
 
@@ -194,6 +215,7 @@ impl<'a> WallRun<'a> {
         for _ in 0..steps {
             self.tick();
         }
+        self.sync_world();
     }
 
     fn run_joint(&mut self, mv: &JointMove) {
@@ -203,10 +225,17 @@ impl<'a> WallRun<'a> {
             self.tick();
         }
         self.q = mv.to.clone();
+        self.sync_world();
     }
 
     /// Follows a straight TCP line; stops (returning the failure) if IK fails on the way.
     fn run_line(&mut self, mv: &LinearMove, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
+        let result = self.follow_line(mv, tcp);
+        self.sync_world();
+        result
+    }
+
+    fn follow_line(&mut self, mv: &LinearMove, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
         for k in 1..=steps {
             let pose = mv.pose_at(k as f64 * self.options.dt);
