@@ -112,7 +112,10 @@ mod tests {
         assert_eq!(p[0], 2.85);
         assert!(p.iter().all(|s| (-3.0..=3.0).contains(s)));
         // Outwards: every later position is at least as far from the start.
-        assert!(p.windows(2).all(|w| (w[1] - 2.85).abs() >= (w[0] - 2.85).abs() - 1e-12));
+        assert!(
+            p.windows(2)
+                .all(|w| (w[1] - 2.85).abs() >= (w[0] - 2.85).abs() - 1e-12)
+        );
         assert!(p.iter().any(|s| (*s + 3.0).abs() < 0.06));
     }
 

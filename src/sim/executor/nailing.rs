@@ -20,6 +20,10 @@ pub(super) const NAIL_STANDOFF: f64 = 0.01;
 /// Where the nailer fires: its nose this far off the plate's face (m).
 pub(super) const NOSE_GAP: f64 = 0.002;
 
+/// A nail's firing pose, the pose its straight approach starts from, the joints there and
+/// the carriage position.
+type ChosenNail = (Isometry3<f64>, Isometry3<f64>, Vec<f64>, f64);
+
 /// One nail as the executor drives it.
 #[derive(Debug, Clone)]
 pub struct NailPlan {
@@ -90,7 +94,7 @@ impl<'a> WallRun<'a> {
             }
             let point = self.wall_cell * Point3::from(Vector3::from(nail.uvw));
             let direction = self.wall_cell.rotation * nail.direction;
-            let mut chosen: Option<(Isometry3<f64>, Isometry3<f64>, Vec<f64>, f64)> = None;
+            let mut chosen: Option<ChosenNail> = None;
             let mut miss: Option<(f64, IkFailure)> = None;
             // The nailer's roll turns its flange towards the base (on a track: the base
             // abeam of the nail).
@@ -107,10 +111,7 @@ impl<'a> WallRun<'a> {
             });
             for (pose, back) in candidates {
                 let attempt = self
-                    .carriage_for(
-                        self.cell.carriage(),
-                        &[(back, nail_tcp), (pose, nail_tcp)],
-                    )
+                    .carriage_for(self.cell.carriage(), &[(back, nail_tcp), (pose, nail_tcp)])
                     .and_then(|s| {
                         let at = self.cell_at(s);
                         let qa = solve(&at, &back, &nail_tcp, &self.q)?;
