@@ -30,6 +30,11 @@ pub(crate) const CELLS: &[(&str, &str, &str)] = &[
         include_str!("../../robots/cells/study-abb.toml"),
     ),
     (
+        "study-abb-track",
+        "robots/cells/study-abb-track.toml",
+        include_str!("../../robots/cells/study-abb-track.toml"),
+    ),
+    (
         "study-kuka",
         "robots/cells/study-kuka.toml",
         include_str!("../../robots/cells/study-kuka.toml"),

@@ -9,6 +9,7 @@ use super::load::looks_like_path;
 use super::robot::Robot;
 use super::toml_file;
 use super::tool::Tool;
+use super::track::Track;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -31,6 +32,21 @@ struct CellFile {
     floor: FloorSection,
     #[serde(default)]
     motion: MotionSection,
+    track: Option<TrackSection>,
+}
+
+/// `[track]`: the robot's base on a linear axis (see `track.rs`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrackSection {
+    /// Direction of travel in the cell frame, degrees about z from +x.
+    direction_deg: f64,
+    /// Rail length, m; the carriage travels ±length/2 about `robot.base_position`.
+    length: f64,
+    /// Programmed carriage speed, m/s.
+    speed: f64,
+    /// Carriage acceleration, m/s².
+    accel: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -363,6 +379,9 @@ pub struct Cell {
     pub pick: Pick,
     pub tool_table: ToolTable,
     pub floor: Floor,
+    /// The linear track the base rides on, if the cell has one; `robot_base` is then the
+    /// base at the carriage's current position.
+    pub track: Option<Track>,
 }
 
 impl Cell {
@@ -403,6 +422,29 @@ impl Cell {
     pub fn set_offset_x(&mut self, text: &str) -> Result<(), String> {
         self.assembly.offset_x = OffsetX::parse(text, self.assembly.auto_range)?;
         Ok(())
+    }
+
+    /// The carriage's position on its track (0 without a track).
+    pub fn carriage(&self) -> f64 {
+        self.track
+            .as_ref()
+            .map_or(0.0, |t| t.position_of(&self.robot_base))
+    }
+
+    /// Moves the base to carriage position `s` (nothing without a track).
+    pub fn set_carriage(&mut self, s: f64) {
+        if let Some(t) = &self.track {
+            self.robot_base = t.base_at(t.clamp(s));
+        }
+    }
+
+    /// The carriage positions to try for a target at `point` (cell frame), nearest `from`
+    /// first; the current position alone without a track.
+    pub fn carriage_positions(&self, from: f64) -> Vec<f64> {
+        match &self.track {
+            Some(t) => t.positions_from(from),
+            None => vec![self.carriage()],
+        }
     }
 
     /// A cell-frame pose in the robot's base_link frame.
@@ -568,6 +610,23 @@ impl Cell {
         size("tool_table", "leg_height", &[t.leg_height], 5.0)?;
         size("floor", "size", &f.floor.size, 1000.0)?;
         check_motion(&f.motion).map_err(|(key, m)| bad("motion", key, m))?;
+        if let Some(tr) = &f.track {
+            finite_angle("track", "direction_deg", tr.direction_deg)?;
+            size("track", "length", &[tr.length], 100.0)?;
+            let positive = |key: &str, v: f64, max: f64, what: &str| {
+                if v.is_finite() && v > 0.0 && v <= max {
+                    Ok(())
+                } else {
+                    Err(bad(
+                        "track",
+                        key,
+                        format!("expected {what} above 0 and at most {max}, got {v}"),
+                    ))
+                }
+            };
+            positive("speed", tr.speed, 10.0, "a carriage speed in m/s")?;
+            positive("accel", tr.accel, 20.0, "a carriage acceleration in m/s²")?;
+        }
         coord("floor", "z", &[f.floor.z])?;
 
         // Payload: the tool alone must not exceed it (the lumber comes on top; the executor checks).
@@ -614,6 +673,20 @@ impl Cell {
             size: s.size,
             face,
         };
+        let robot_base = Isometry3::from_parts(
+            Translation3::from(Vector3::from(f.robot.base_position)),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, f.robot.base_yaw_deg.to_radians()),
+        );
+        let track = f.track.as_ref().map(|tr| {
+            let a = tr.direction_deg.to_radians();
+            Track {
+                home: robot_base,
+                direction: Vector3::new(a.cos(), a.sin(), 0.0),
+                travel: [-tr.length / 2.0, tr.length / 2.0],
+                speed: tr.speed,
+                accel: tr.accel,
+            }
+        });
         let mut cell = Cell {
             name: f.name.unwrap_or_else(|| {
                 path.file_stem()
@@ -622,10 +695,7 @@ impl Cell {
             description: f.description,
             source: path.to_path_buf(),
             robot,
-            robot_base: Isometry3::from_parts(
-                Translation3::from(Vector3::from(f.robot.base_position)),
-                UnitQuaternion::from_euler_angles(0.0, 0.0, f.robot.base_yaw_deg.to_radians()),
-            ),
+            robot_base,
             tool,
             assembly: Assembly {
                 offset_x,
@@ -659,6 +729,7 @@ impl Cell {
                 size: f.floor.size,
                 z: f.floor.z,
             },
+            track,
         };
         cell.check_pick(&s.pick_heights)
             .map_err(|m| bad("touch_sensor", "pick_offset", m))?;

@@ -18,6 +18,7 @@ mod shapes;
 pub mod tcp_poses;
 mod toml_file;
 mod tool;
+pub mod track;
 mod urdf_depth;
 
 pub use builtin::{cell_names, robot_names, tool_names};
@@ -31,6 +32,7 @@ pub use meta::{OpwParams, RobotMeta};
 pub use robot::{Inertial, Joint, JointKind, Link, Robot};
 pub use shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};
 pub use tool::{Gripper, Tool, ToolPart};
+pub use track::Track;
 
 use nalgebra::Isometry3;
 

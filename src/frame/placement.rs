@@ -349,7 +349,7 @@ pub fn reaches(cell: &Cell, target: &Isometry3<f64>, size: &[f64; 3]) -> bool {
             return false;
         };
         let above = Translation3::new(0.0, 0.0, APPROACH_HEIGHT) * place;
-        solves_above_floor(cell, &place, grip) && solves_above_floor(cell, &above, grip)
+        reached_together(cell, &[place, above], grip)
     })
 }
 
@@ -363,8 +363,28 @@ pub fn nail_reached(cell: &Cell, point: &Point3<f64>, direction: &Vector3<f64>) 
         .any(|roll| {
             let fire = retreat(&nail_pose(point, direction, roll), NOSE_GAP);
             let back = retreat(&fire, NAIL_APPROACH);
-            solves_above_floor(cell, &fire, tcp) && solves_above_floor(cell, &back, tcp)
+            reached_together(cell, &[fire, back], tcp)
         })
+}
+
+/// Whether the arm reaches every one of `poses` (robot frame, the carriage at home) from
+/// one base position: the base itself, or on a track some carriage position (tried from the
+/// one abeam of the first pose outwards).
+fn reached_together(cell: &Cell, poses: &[Isometry3<f64>], tcp: &Isometry3<f64>) -> bool {
+    let Some(track) = &cell.track else {
+        return poses.iter().all(|p| solves_above_floor(cell, p, tcp));
+    };
+    let Some(first) = poses.first() else {
+        return true;
+    };
+    let abeam = track.abeam(&Point3::from((cell.robot_base * first).translation.vector));
+    track.positions_from(abeam).into_iter().any(|s| {
+        // Robot frame at home → robot frame with the carriage at s.
+        let shift = track.base_at(s).inverse() * cell.robot_base;
+        poses
+            .iter()
+            .all(|p| solves_above_floor(cell, &(shift * p), tcp))
+    })
 }
 
 /// Whether some exact IK solution of a robot-frame TCP pose keeps the arm and its tool above

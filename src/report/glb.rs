@@ -68,9 +68,16 @@ pub fn wall_glb(
             .iter()
             .map(|&i| cell.robot.fk_all(&trace.joints[i]))
             .collect();
+        // The base where the sample had it (a carriage on a track moves it): tool0 as the
+        // executor computed it, less the arm's own forward kinematics.
+        let bases: Vec<Isometry3<f64>> = kept
+            .iter()
+            .zip(&fk)
+            .map(|(&i, f)| trace.tool[i] * f[cell.robot.tip].inverse())
+            .collect();
         for (link, node) in &links {
             let poses: Vec<Isometry3<f64>> =
-                fk.iter().map(|f| cell.robot_base * f[*link]).collect();
+                fk.iter().zip(&bases).map(|(f, b)| b * f[*link]).collect();
             let (t, p) = until(&times, &poses, end);
             animation.pose(&mut g, *node, &t, &p);
         }

@@ -166,6 +166,18 @@ pub(super) fn plan_view(cell: &Cell, view: &WallView, thickness: f64) -> Markup 
         .collect();
     let r = reach.unwrap_or(0.5).max(0.5);
     extent.extend([[base.x - r, base.y - r], [base.x + r, base.y + r]]);
+    // On a track the base runs along the rail; its reach is a stadium around the rail.
+    let rail: Option<[[f64; 2]; 2]> = cell.track.as_ref().map(|t| {
+        t.travel.map(|s| {
+            let b = t.base_at(s).translation.vector;
+            [b.x, b.y]
+        })
+    });
+    if let Some(ends) = rail {
+        for e in ends {
+            extent.extend([[e[0] - r, e[1] - r], [e[0] + r, e[1] + r]]);
+        }
+    }
     for c in [&cell.conveyor1, &cell.conveyor2] {
         for e in [c.upstream_end(), c.downstream_end()] {
             extent.push([e.x, e.y]);
@@ -249,7 +261,17 @@ pub(super) fn plan_view(cell: &Cell, view: &WallView, thickness: f64) -> Markup 
                     title { (tooltip(p)) }
                 }
             }
-            @if let Some(r) = reach {
+            @if let Some(ends) = rail {
+                line class="track" x1=(f1(x(ends[0][0]))) y1=(f1(y(ends[0][1]))) x2=(f1(x(ends[1][0]))) y2=(f1(y(ends[1][1]))) stroke="#6d4c41" stroke-width="6" stroke-linecap="round" {
+                    title { (format!("linear track: the base travels {:.2} m", ((ends[1][0] - ends[0][0]).powi(2) + (ends[1][1] - ends[0][1]).powi(2)).sqrt())) }
+                }
+                @if let Some(r) = reach {
+                    polygon class="reach" points=(points(&stadium(ends, r))) fill="none" stroke="#1565c0" stroke-width="2" stroke-dasharray="8 4" {
+                        title { (format!("reach of the grip straight down at the assembly surface, {r:.3} m, from anywhere on the track")) }
+                    }
+                }
+            }
+            @if let (Some(r), None) = (reach, rail) {
                 circle class="reach" cx=(f1(x(base.x))) cy=(f1(y(base.y))) r=(f1(r * s)) fill="none" stroke="#1565c0" stroke-width="2" stroke-dasharray="8 4" {
                     title { (format!("reach of the grip straight down at the assembly surface: {r:.3} m")) }
                 }
@@ -260,6 +282,23 @@ pub(super) fn plan_view(cell: &Cell, view: &WallView, thickness: f64) -> Markup 
             (scale_bar(MARGIN, height - 15.0, s))
         }
     }
+}
+
+/// The outline of every point within `r` of the segment between `ends` (x/y), as a polygon:
+/// a half circle around each end joined by straight sides.
+fn stadium(ends: [[f64; 2]; 2], r: f64) -> Vec<[f64; 2]> {
+    let [a, b] = ends;
+    let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+    let half = |centre: [f64; 2], from: f64| {
+        (0..=24).map(move |k| {
+            let angle = from + std::f64::consts::PI * k as f64 / 24.0;
+            [centre[0] + r * angle.cos(), centre[1] + r * angle.sin()]
+        })
+    };
+    let quarter = std::f64::consts::FRAC_PI_2;
+    half(b, heading - quarter)
+        .chain(half(a, heading + quarter))
+        .collect()
 }
 
 /// The operations of a wall's run on a time axis: a row per element, a bar per operation

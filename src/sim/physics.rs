@@ -449,6 +449,12 @@ impl Physics {
         ))
     }
 
+    /// Moves the robot's base (its carriage on a linear track); the links follow at the
+    /// next drive or placement.
+    pub fn set_robot_base(&mut self, base: nalgebra::Isometry3<f64>) {
+        self.cell.robot_base = base;
+    }
+
     /// Moves the robot's bodies to joint values `q` by the end of the next step.
     pub fn drive_robot(&mut self, q: &[f64]) {
         let poses = self.cell.robot.fk_all(q);

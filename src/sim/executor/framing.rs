@@ -40,6 +40,9 @@ struct FramingPlan {
     pick_body: Isometry3<f64>,
     /// The target orientation actually used (a box has four equivalent ones).
     target: Isometry3<f64>,
+    /// Where the carriage stands (on a track) to pick and to place.
+    carriage_pick: f64,
+    carriage_place: f64,
 }
 
 impl<'a> WallRun<'a> {
@@ -109,12 +112,17 @@ impl<'a> WallRun<'a> {
         if let Some(current) = &mut self.current {
             current.2.clear();
         }
-        if let Err(failure) = self.move_to(
-            &plan.q_above_pick.clone(),
-            &grip,
-            &[],
-            self.transfer_speed(),
-        ) {
+        if let Err(failure) = self
+            .move_carriage(plan.carriage_pick, &grip, &[])
+            .and_then(|()| {
+                self.move_to(
+                    &plan.q_above_pick.clone(),
+                    &grip,
+                    &[],
+                    self.transfer_speed(),
+                )
+            })
+        {
             self.record_line_failure(piece, "pick", failure);
             self.end(id, "pick", start);
             self.take_off(id);
@@ -195,12 +203,19 @@ impl<'a> WallRun<'a> {
         self.start_belts(id);
         self.end(id, "pick", start);
 
+        // Move above the target: the carriage to its place position, then the arm.
+        let start = self.begin(id, "move", &[]);
+        let carried = if ok {
+            self.move_carriage(plan.carriage_place, &grip, &[])
+        } else {
+            Ok(())
+        };
         // The place pose from how the piece actually sits in the gripper.
         let (place, q_above_place) = match &self.held {
             Some(h) => {
                 let place = plan.target * h.in_tool.inverse() * grip;
                 match solve(
-                    self.cell,
+                    &self.cell,
                     &raise(&place, CLEARANCE),
                     &grip,
                     &plan.q_above_place,
@@ -211,10 +226,9 @@ impl<'a> WallRun<'a> {
             }
             None => (plan.place, plan.q_above_place.clone()),
         };
-
-        // Move above the target.
-        let start = self.begin(id, "move", &[]);
-        if ok && let Err(failure) = self.move_to(&q_above_place, &grip, &[], self.transfer_speed())
+        if ok
+            && let Err(failure) = carried
+                .and_then(|()| self.move_to(&q_above_place, &grip, &[], self.transfer_speed()))
         {
             // No way to the target with the piece: the arm lets go where it is and the piece
             // is taken out of the cell.
@@ -343,13 +357,29 @@ impl<'a> WallRun<'a> {
                     continue;
                 }
                 let attempt = (|| {
+                    // Where the carriage stands (on a track): nearest the current position
+                    // for the pick, nearest the pick position for the place.
+                    let carriage_pick = self
+                        .carriage_for(
+                            self.cell.carriage(),
+                            &[(pick, grip), (raise(&pick, CLEARANCE), grip)],
+                        )
+                        .map_err(|f| ("pick", f))?;
+                    let carriage_place = self
+                        .carriage_for(
+                            carriage_pick,
+                            &[(place, grip), (raise(&place, CLEARANCE), grip)],
+                        )
+                        .map_err(|f| ("place", f))?;
+                    let at_pick = self.cell_at(carriage_pick);
+                    let at_place = self.cell_at(carriage_place);
                     // The pick and place poses themselves first: when one is out of the arm's
                     // range, that (not its approach above) is the miss to report.
-                    solve(self.cell, &pick, &grip, &self.q).map_err(|f| ("pick", f))?;
-                    solve(self.cell, &place, &grip, &self.q).map_err(|f| ("place", f))?;
+                    solve(&at_pick, &pick, &grip, &self.q).map_err(|f| ("pick", f))?;
+                    solve(&at_place, &place, &grip, &self.q).map_err(|f| ("place", f))?;
                     // Descents on a branch that exists all the way down.
                     let (q_above_pick, q_pick) = continuous_line(
-                        self.cell,
+                        &at_pick,
                         &self.q,
                         &raise(&pick, CLEARANCE),
                         &pick,
@@ -358,7 +388,7 @@ impl<'a> WallRun<'a> {
                     )
                     .map_err(|f| ("pick", f))?;
                     let (q_above_place, q_place) = continuous_line(
-                        self.cell,
+                        &at_place,
                         &q_above_pick,
                         &raise(&place, CLEARANCE),
                         &place,
@@ -366,45 +396,42 @@ impl<'a> WallRun<'a> {
                         LINE_SAMPLES,
                     )
                     .map_err(|f| ("place", f))?;
-                    Ok::<_, (&'static str, IkFailure)>((
-                        q_above_pick,
-                        q_pick,
-                        q_above_place,
-                        q_place,
-                    ))
-                })();
-                match attempt {
-                    Err((op, f)) => note_miss(op, f),
-                    Ok((q_above_pick, q_pick, q_above_place, q_place)) => {
+                    let blocked = {
                         let held_in_tool = grip * in_body.inverse();
                         let half = piece.size.map(|v| v / 2.0);
                         let held = Some((piece.id.as_str(), &held_in_tool, half));
-                        let blocked = touches(&self.phys, self.cell, &q_place, held, &[], 0.0)
-                            .or_else(|| {
-                                touches(&self.phys, self.cell, &q_pick, None, &[&piece.id], 0.0)
-                            });
-                        if let Some((a, b)) = blocked {
-                            // A reachable pose that collides: the closest kind of miss.
-                            note_miss("place", IkFailure::AllSolutionsCollide { pair: [a, b] });
-                            continue;
-                        }
-                        let travel = distance(&self.q, &q_above_pick)
-                            + distance(&q_above_pick, &q_above_place);
+                        touches(&self.phys, &at_place, &q_place, held, &[], 0.0).or_else(|| {
+                            touches(&self.phys, &at_pick, &q_pick, None, &[&piece.id], 0.0)
+                        })
+                    };
+                    if let Some((a, b)) = blocked {
+                        // A reachable pose that collides: the closest kind of miss.
+                        return Err(("place", IkFailure::AllSolutionsCollide { pair: [a, b] }));
+                    }
+                    Ok::<_, (&'static str, IkFailure)>(FramingPlan {
+                        pick_body: body,
+                        pick_margin: reach_margin(&at_pick, &pick, &grip),
+                        place_margin: reach_margin(&at_place, &place, &grip),
+                        pick,
+                        place,
+                        q_above_pick,
+                        q_above_place,
+                        target,
+                        carriage_pick,
+                        carriage_place,
+                    })
+                })();
+                match attempt {
+                    Err((op, f)) => note_miss(op, f),
+                    Ok(plan) => {
+                        // Joint travel (rad) and carriage travel (m) alike count as travel.
+                        let travel = distance(&self.q, &plan.q_above_pick)
+                            + distance(&plan.q_above_pick, &plan.q_above_place)
+                            + (plan.carriage_pick - self.cell.carriage()).abs()
+                            + (plan.carriage_place - plan.carriage_pick).abs();
                         let score = (1.0 - down) * 100.0 + travel;
                         if best.as_ref().is_none_or(|b| score < b.0) {
-                            best = Some((
-                                score,
-                                FramingPlan {
-                                    pick_body: body,
-                                    pick_margin: reach_margin(self.cell, &pick, &grip),
-                                    place_margin: reach_margin(self.cell, &place, &grip),
-                                    pick,
-                                    place,
-                                    q_above_pick,
-                                    q_above_place,
-                                    target,
-                                },
-                            ));
+                            best = Some((score, plan));
                         }
                     }
                 }

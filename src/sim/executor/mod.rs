@@ -10,6 +10,7 @@
 //! records of contacts.
 
 mod as_built;
+mod carriage;
 mod feeding;
 mod framing;
 mod nailing;
@@ -44,7 +45,8 @@ pub(super) struct Held {
 }
 
 pub struct WallRun<'a> {
-    cell: &'a Cell,
+    /// The run's own copy of the cell: with a track, its `robot_base` follows the carriage.
+    cell: Cell,
     options: &'a SimOptions,
     phys: Physics,
     wall_cell: Isometry3<f64>,
@@ -92,7 +94,7 @@ impl<'a> WallRun<'a> {
             );
         }
         WallRun {
-            cell,
+            cell: cell.clone(),
             options,
             phys,
             wall_cell: cell.robot_base * wall.wall_to_robot,
@@ -239,8 +241,8 @@ impl<'a> WallRun<'a> {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
         for k in 1..=steps {
             let pose = mv.pose_at(k as f64 * self.options.dt);
-            let next = solve(self.cell, &pose, tcp, &self.q)?;
-            check_step(self.cell, &self.q, &next, k as f64 / steps as f64)?;
+            let next = solve(&self.cell, &pose, tcp, &self.q)?;
+            check_step(&self.cell, &self.q, &next, k as f64 / steps as f64)?;
             self.q = next;
             self.tick();
         }

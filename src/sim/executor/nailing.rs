@@ -20,6 +20,10 @@ pub(super) const NAIL_STANDOFF: f64 = 0.01;
 /// Where the nailer fires: its nose this far off the plate's face (m).
 pub(super) const NOSE_GAP: f64 = 0.002;
 
+/// A nail's firing pose, the pose its straight approach starts from, the joints there and
+/// the carriage position.
+type ChosenNail = (Isometry3<f64>, Isometry3<f64>, Vec<f64>, f64);
+
 /// One nail as the executor drives it.
 #[derive(Debug, Clone)]
 pub struct NailPlan {
@@ -90,9 +94,14 @@ impl<'a> WallRun<'a> {
             }
             let point = self.wall_cell * Point3::from(Vector3::from(nail.uvw));
             let direction = self.wall_cell.rotation * nail.direction;
-            let mut chosen: Option<(Isometry3<f64>, Isometry3<f64>, Vec<f64>)> = None;
+            let mut chosen: Option<ChosenNail> = None;
             let mut miss: Option<(f64, IkFailure)> = None;
-            let base = Point3::from(self.cell.robot_base.translation.vector);
+            // The nailer's roll turns its flange towards the base (on a track: the base
+            // abeam of the nail).
+            let base = match &self.cell.track {
+                Some(t) => Point3::from(t.base_at(t.abeam(&point)).translation.vector),
+                None => Point3::from(self.cell.robot_base.translation.vector),
+            };
             let rolls = nail_rolls(&point, &direction, &base);
             let candidates = rolls.into_iter().flat_map(|roll| {
                 // The nose stops just short of the face: pressed against the work, the
@@ -101,19 +110,23 @@ impl<'a> WallRun<'a> {
                 nail_approaches(pose).map(move |back| (pose, back))
             });
             for (pose, back) in candidates {
-                let attempt = solve(self.cell, &back, &nail_tcp, &self.q).and_then(|qa| {
-                    let q_nail = line(self.cell, &qa, &back, &pose, &nail_tcp, 4)?;
-                    let ignore = [nail.plate.as_str(), nail.member.as_str()];
-                    match touches(&self.phys, self.cell, &q_nail, None, &ignore, 0.0)
-                        .or_else(|| touches(&self.phys, self.cell, &qa, None, &ignore, 0.0))
-                    {
-                        Some((a, b)) => Err(IkFailure::AllSolutionsCollide { pair: [a, b] }),
-                        None => Ok(qa),
-                    }
-                });
+                let attempt = self
+                    .carriage_for(self.cell.carriage(), &[(back, nail_tcp), (pose, nail_tcp)])
+                    .and_then(|s| {
+                        let at = self.cell_at(s);
+                        let qa = solve(&at, &back, &nail_tcp, &self.q)?;
+                        let q_nail = line(&at, &qa, &back, &pose, &nail_tcp, 4)?;
+                        let ignore = [nail.plate.as_str(), nail.member.as_str()];
+                        match touches(&self.phys, &at, &q_nail, None, &ignore, 0.0)
+                            .or_else(|| touches(&self.phys, &at, &qa, None, &ignore, 0.0))
+                        {
+                            Some((a, b)) => Err(IkFailure::AllSolutionsCollide { pair: [a, b] }),
+                            None => Ok((qa, s)),
+                        }
+                    });
                 match attempt {
-                    Ok(q_back) => {
-                        chosen = Some((pose, back, q_back));
+                    Ok((q_back, s)) => {
+                        chosen = Some((pose, back, q_back, s));
                         break;
                     }
                     Err(f) => {
@@ -124,7 +137,7 @@ impl<'a> WallRun<'a> {
                     }
                 }
             }
-            let Some((pose, back, q_back)) = chosen else {
+            let Some((pose, back, q_back, carriage)) = chosen else {
                 let failure = miss.map_or(IkFailure::InvalidPose, |m| m.1);
                 let (kind, what, value, limit) = failure_columns(&failure);
                 self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
@@ -132,7 +145,10 @@ impl<'a> WallRun<'a> {
             };
             let plate = nail.plate.clone();
             let start = self.begin(&plate, "nail", &[nail.member.as_str()]);
-            if let Err(failure) = self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()) {
+            if let Err(failure) = self
+                .move_carriage(carriage, &nail_tcp, &[])
+                .and_then(|()| self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()))
+            {
                 self.end(&plate, "nail", start);
                 let (kind, what, value, limit) = failure_columns(&failure);
                 self.skip_nail(nail, kind, &what, value, limit, failure.to_string());

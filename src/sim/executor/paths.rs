@@ -99,7 +99,7 @@ impl<'a> WallRun<'a> {
                 Translation3::from(pose.translation.vector + Vector3::new(0.0, 0.0, h)),
                 pose.rotation,
             );
-            solve(self.cell, &raised, tcp, q).ok()
+            solve(&self.cell, &raised, tcp, q).ok()
         };
         // Raised waypoints over both ends, then the same through the robot's home pose (a
         // transit pose that turns the wrist high above the work).
@@ -134,7 +134,7 @@ impl<'a> WallRun<'a> {
             let point_free = |q: &[f64]| {
                 let near_end = joint_gap(q, from).min(joint_gap(q, to));
                 let margin = PATH_MARGIN * (near_end / END_TAPER).clamp(0.0, 1.0);
-                touches(&self.phys, self.cell, q, held, ignore, margin).is_none()
+                touches(&self.phys, &self.cell, q, held, ignore, margin).is_none()
             };
             let leg_free =
                 |a: &[f64], b: &[f64]| self.path_clear(&[a.to_vec(), b.to_vec()], ignore);
@@ -184,7 +184,7 @@ impl<'a> WallRun<'a> {
             let rotation = base.rotation * yaw * (base.rotation.inverse() * a.rotation);
             let point = base * Point3::new(r * th.cos(), r * th.sin(), z);
             let pose = Isometry3::from_parts(Translation3::from(point.coords), rotation);
-            q = solve(self.cell, &pose, tcp, &q).ok()?;
+            q = solve(&self.cell, &pose, tcp, &q).ok()?;
             path.push(q.clone());
         }
         path.push(to.to_vec());
@@ -220,7 +220,7 @@ impl<'a> WallRun<'a> {
                 let from_end = (travelled + s * length).min(total - travelled - s * length);
                 let margin = PATH_MARGIN * (from_end / MARGIN_TAPER).clamp(0.0, 1.0);
                 let q = lerp(&leg[0], &leg[1], s);
-                if let Some(pair) = touches(&self.phys, self.cell, &q, held, ignore, margin) {
+                if let Some(pair) = touches(&self.phys, &self.cell, &q, held, ignore, margin) {
                     return Some(pair);
                 }
             }
