@@ -206,6 +206,13 @@ impl<'a> WallRun<'a> {
         self.events.robot_stale = false;
     }
 
+    /// The robot's base moved (its carriage on a track) while its joints held: a clearance
+    /// measured from joint travel alone no longer holds, and the bodies must be placed anew.
+    pub(super) fn base_moved(&mut self) {
+        self.events.anchor = None;
+        self.events.robot_stale = true;
+    }
+
     /// Brings the world up to the run's clock after ticks without the solver: the robot's
     /// bodies at `self.q`, riders where the belts have carried them. The executor calls it
     /// when a motion ends, before it plans, grips, releases or measures.
