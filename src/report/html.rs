@@ -272,8 +272,21 @@ fn validation(report: &SimReport) -> Markup {
     }
 }
 
+/// Swaps two folders in one step, so a reader of `b` sees the old report or the new one,
+/// never none (Linux's renameat2 with RENAME_EXCHANGE).
+#[cfg(target_os = "linux")]
+fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
+    use rustix::fs::{CWD, RenameFlags, renameat_with};
+    renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE).map_err(std::io::Error::from)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
+    Err(std::io::Error::from(std::io::ErrorKind::Unsupported))
+}
+
 /// Writes the report's files into `dir`: built in a fresh temporary folder beside it, then
-/// renamed into place (an existing `dir` is replaced only once the new one is complete).
+/// swapped into place (an existing `dir` is replaced only once the new one is complete).
 pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
     let files = report_files(input);
     let parent = match dir.parent() {
@@ -304,6 +317,11 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
                     "the folder exists and holds no earlier report; name a new folder",
                 ));
             }
+            if exchange(&tmp, dir).is_ok() {
+                // `dir` is the new report at once; `tmp` now holds the earlier one.
+                return std::fs::remove_dir_all(&tmp);
+            }
+            // Where the filesystem cannot exchange two folders, `dir` is briefly absent.
             std::fs::rename(dir, &old)?;
             std::fs::rename(&tmp, dir)?;
             std::fs::remove_dir_all(&old)
