@@ -62,17 +62,26 @@ fn entries(bcfzip: &Path) -> Vec<(String, String)> {
 }
 
 /// Validates every XML document of the archive against buildingSMART's BCF-XML schemas of
-/// `version`, as shipped inside IfcOpenShell's `bcf` package (bcf-client 0.7.10 carries them
-/// under `bcf/v2/xsd` and `bcf/v3/xsd`), with `xmlschema`. Skips, saying so, without them.
+/// `version` with `xmlschema`. The schemas come from bcf-client 0.7.10 (IfcOpenShell's BCF
+/// package, which ships them as `bcf/v2/xsd` and `bcf/v3/xsd`; later releases do not), installed
+/// apart as `.ci/run` does (`pip install --no-deps --target target/bcf-xsd bcf-client==0.7.10`;
+/// another folder through `FRAMEWRIGHT_BCF_XSD_DIR`), or from the installed `bcf` package when
+/// it carries them. Skips, saying so, without them.
 const XSD_CHECK: &str = r#"
-import os, sys, zipfile
+import importlib.util, os, sys, zipfile
 import xmlschema
-import bcf
 version, path = sys.argv[1], sys.argv[2]
-folder = os.path.join(os.path.dirname(bcf.__file__), "v3" if version == "3.0" else "v2", "xsd")
-if not os.path.isdir(folder):
-    print("NO-XSD " + folder)
+sub = os.path.join("bcf", "v3" if version == "3.0" else "v2", "xsd")
+bases = [b for b in sys.argv[3:] if b]
+spec = importlib.util.find_spec("bcf")
+if spec and spec.submodule_search_locations:
+    bases.append(os.path.dirname(list(spec.submodule_search_locations)[0]))
+folders = [os.path.join(b, sub) for b in bases if os.path.isdir(os.path.join(b, sub))]
+if not folders:
+    print("NO-XSD " + " ".join(bases))
     sys.exit(0)
+folder = folders[0]
+print("SCHEMAS " + folder)
 by_name = {"bcf.version": "version.xsd", "project.bcfp": "project.xsd",
            "extensions.xml": "extensions.xsd", "documents.xml": "documents.xsd"}
 by_ext = {".bcf": "markup.xsd", ".bcfv": "visinfo.xsd"}
@@ -98,22 +107,22 @@ sys.exit(1 if failed else 0)
 "#;
 
 fn validate_against_schemas(bcfzip: &Path, version: &str) {
-    let Some(python) =
-        common::python::python_with(&["xmlschema", "bcf"], "xmlschema bcf-client==0.7.10")
-    else {
+    let Some(python) = common::python::python_with(&["xmlschema"], "xmlschema") else {
         return;
     };
     let run = Command::new(python)
         .args(["-c", XSD_CHECK, version])
         .arg(bcfzip)
+        .arg(std::env::var("FRAMEWRIGHT_BCF_XSD_DIR").unwrap_or_default())
+        .arg(root().join("target/bcf-xsd"))
         .output()
         .unwrap();
     let out = String::from_utf8_lossy(&run.stdout);
-    if let Some(folder) = out.strip_prefix("NO-XSD ") {
+    if let Some(looked) = out.strip_prefix("NO-XSD ") {
         eprintln!(
-            "skipped: the installed bcf package ships no BCF-XML schemas ({}); \
-             pip install bcf-client==0.7.10",
-            folder.trim()
+            "skipped: no BCF-XML schemas in {}; pip install --no-deps --target \
+             target/bcf-xsd bcf-client==0.7.10",
+            looked.trim()
         );
         return;
     }

@@ -105,10 +105,15 @@ fn parse_body(body: &[u8]) -> Option<PoseTrace> {
     let mut r = Reader(body);
     let n = r.count(8)?;
     let j = r.count(8 * n)?;
-    let mut trace = PoseTrace::default();
-    trace.times = r.floats(n)?;
-    trace.joints = (0..n).map(|_| r.floats(j)).collect::<Option<_>>()?;
-    trace.tool = (0..n).map(|_| r.pose()).collect::<Option<_>>()?;
+    let times = r.floats(n)?;
+    let joints = (0..n).map(|_| r.floats(j)).collect::<Option<_>>()?;
+    let tool = (0..n).map(|_| r.pose()).collect::<Option<_>>()?;
+    let mut trace = PoseTrace {
+        times,
+        joints,
+        tool,
+        ..PoseTrace::default()
+    };
     let pieces = r.count(16)?;
     for _ in 0..pieces {
         let len = r.count(1)?;
