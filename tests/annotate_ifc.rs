@@ -197,7 +197,7 @@ fn hostile_names_survive() {
             .any(|n| n.ends_with(&format!(" {HOSTILE_STUD}"))),
         "{names:?}"
     );
-    if let Some(python) = ifcopenshell() {
+    if let Some(python) = common::python::ifcopenshell() {
         let script = "import sys, json, ifcopenshell\nf = ifcopenshell.open(sys.argv[1])\nprint(json.dumps(sorted(t.Name for t in f.by_type('IfcTask'))))";
         let run = Command::new(python)
             .args(["-c", script, out.to_str().unwrap()])
@@ -274,22 +274,10 @@ fn a_bad_date_is_refused() {
     assert!(String::from_utf8_lossy(&dated).contains("'2026-03-01T08:00:00'"));
 }
 
-/// `python3` when it imports ifcopenshell; otherwise None, after saying what is skipped.
-fn ifcopenshell() -> Option<&'static str> {
-    let ok = Command::new("python3")
-        .args(["-c", "import ifcopenshell"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        eprintln!("skipped: python3 with ifcopenshell is absent (pip install ifcopenshell)");
-    }
-    ok.then_some("python3")
-}
-
 /// IfcOpenShell's validator and the plan checks of `bench/annotate_oracle.py`.
 #[test]
 fn ifcopenshell_validates_and_finds_the_plan() {
-    let Some(python) = ifcopenshell() else {
+    let Some(python) = common::python::ifcopenshell() else {
         return;
     };
     let rules = Command::new(python)

@@ -1,11 +1,13 @@
 //! `simulate … --bcf`: one topic per root cause per wall, read back by an independent BCF
 //! reader (IfcOpenShell's `bcf` package, `bench/bcf_oracle.py`, skipped when absent) for
-//! BCF 3.0 and 2.1; stable GUIDs and identical bytes on a re-run; hostile names intact.
+//! BCF 3.0 and 2.1; every XML document valid against buildingSMART's BCF-XML schemas of its
+//! version (when installed); stable GUIDs and identical bytes on a re-run; hostile names intact.
+
+mod common;
 
 use quick_xml::Reader;
 use quick_xml::events::Event;
 use serde_json::Value;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -35,14 +37,9 @@ fn simulate(model: &Path, out: &Path, extra: &[&str]) -> Value {
 
 /// Every entry of the archive, by name; each XML entry must be well-formed.
 fn entries(bcfzip: &Path) -> Vec<(String, String)> {
-    let mut archive = zip::ZipArchive::new(std::fs::File::open(bcfzip).unwrap()).unwrap();
     let mut out = Vec::new();
-    for i in 0..archive.len() {
-        let mut f = archive.by_index(i).unwrap();
-        let name = f.name().unwrap().to_string();
-        if name.ends_with(".png") {
-            let mut bytes = Vec::new();
-            f.read_to_end(&mut bytes).unwrap();
+    for (name, bytes) in common::bcf::entries(bcfzip) {
+        if common::bcf::is_image(&name) {
             assert!(
                 bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.len() > 100,
                 "{name} is not a PNG image"
@@ -50,8 +47,7 @@ fn entries(bcfzip: &Path) -> Vec<(String, String)> {
             out.push((name, String::new()));
             continue;
         }
-        let mut text = String::new();
-        f.read_to_string(&mut text).unwrap();
+        let text = String::from_utf8(bytes).unwrap();
         let mut reader = Reader::from_str(&text);
         loop {
             match reader.read_event() {
@@ -65,17 +61,93 @@ fn entries(bcfzip: &Path) -> Vec<(String, String)> {
     out
 }
 
+/// Validates every XML document of the archive against buildingSMART's BCF-XML schemas of
+/// `version` with `xmlschema`. The schemas come from bcf-client 0.7.10 (IfcOpenShell's BCF
+/// package, which ships them as `bcf/v2/xsd` and `bcf/v3/xsd`; later releases do not), installed
+/// apart as `.ci/run` does (`pip install --no-deps --target target/bcf-xsd bcf-client==0.7.10`;
+/// another folder through `FRAMEWRIGHT_BCF_XSD_DIR`), or from the installed `bcf` package when
+/// it carries them. Skips, saying so, without them.
+const XSD_CHECK: &str = r#"
+import importlib.util, os, sys, zipfile
+import xmlschema
+version, path = sys.argv[1], sys.argv[2]
+sub = os.path.join("bcf", "v3" if version == "3.0" else "v2", "xsd")
+bases = [b for b in sys.argv[3:] if b]
+spec = importlib.util.find_spec("bcf")
+if spec and spec.submodule_search_locations:
+    bases.append(os.path.dirname(list(spec.submodule_search_locations)[0]))
+folders = [os.path.join(b, sub) for b in bases if os.path.isdir(os.path.join(b, sub))]
+if not folders:
+    print("NO-XSD " + " ".join(bases))
+    sys.exit(0)
+folder = folders[0]
+print("SCHEMAS " + folder)
+by_name = {"bcf.version": "version.xsd", "project.bcfp": "project.xsd",
+           "extensions.xml": "extensions.xsd", "documents.xml": "documents.xsd"}
+by_ext = {".bcf": "markup.xsd", ".bcfv": "visinfo.xsd"}
+schemas, failed = {}, 0
+with zipfile.ZipFile(path) as z:
+    for name in sorted(z.namelist()):
+        if name.endswith(".png"):
+            continue
+        base = name.rsplit("/", 1)[-1]
+        xsd = by_name.get(base) or by_ext.get(os.path.splitext(base)[1])
+        if xsd is None:
+            print("UNKNOWN " + name)
+            failed += 1
+            continue
+        if xsd not in schemas:
+            schemas[xsd] = xmlschema.XMLSchema(os.path.join(folder, xsd))
+        errors = list(schemas[xsd].iter_errors(z.read(name).decode("utf-8")))
+        for e in errors:
+            print("INVALID %s (%s): %s" % (name, xsd, e.reason))
+        failed += bool(errors)
+        print("CHECKED %s %s" % (name, xsd))
+sys.exit(1 if failed else 0)
+"#;
+
+fn validate_against_schemas(bcfzip: &Path, version: &str) {
+    let Some(python) = common::python::python_with(&["xmlschema"], "xmlschema") else {
+        return;
+    };
+    let run = Command::new(python)
+        .args(["-c", XSD_CHECK, version])
+        .arg(bcfzip)
+        .arg(std::env::var("FRAMEWRIGHT_BCF_XSD_DIR").unwrap_or_default())
+        .arg(root().join("target/bcf-xsd"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&run.stdout);
+    if let Some(looked) = out.strip_prefix("NO-XSD ") {
+        eprintln!(
+            "skipped: no BCF-XML schemas in {}; pip install --no-deps --target \
+             target/bcf-xsd bcf-client==0.7.10",
+            looked.trim()
+        );
+        return;
+    }
+    assert!(
+        run.status.success(),
+        "{} does not follow the BCF {version} schemas:\n{out}{}",
+        bcfzip.display(),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let names: Vec<String> = entries(bcfzip)
+        .into_iter()
+        .map(|(n, _)| n)
+        .filter(|n| !common::bcf::is_image(n))
+        .collect();
+    assert_eq!(
+        out.lines().filter(|l| l.starts_with("CHECKED ")).count(),
+        names.len(),
+        "every XML document checked: {out}"
+    );
+}
+
 /// The oracle's reading, or None (after saying so) when python3 or bcf-client is absent.
 fn read_back(bcfzip: &Path) -> Option<Value> {
-    let ok = Command::new("python3")
-        .args(["-c", "import bcf.bcfxml"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        eprintln!("skipped: python3 with bcf-client is absent (pip install bcf-client)");
-        return None;
-    }
-    let run = Command::new("python3")
+    let python = common::python::python_with(&["bcf.bcfxml"], "bcf-client")?;
+    let run = Command::new(python)
         .arg(root().join("bench/bcf_oracle.py"))
         .arg(bcfzip)
         .output()
@@ -120,6 +192,7 @@ fn check(bcfzip: &Path, version: &str, report: &Value) -> Option<Value> {
             assert!(text.contains("<Snapshot>snapshot.png</Snapshot>"), "{text}");
         }
     }
+    validate_against_schemas(bcfzip, version);
     let read = read_back(bcfzip)?;
     assert_eq!(read["version"], version);
     let topics = read["topics"].as_array().unwrap();
@@ -223,6 +296,7 @@ fn hostile_names_survive() {
     for version in ["3.0", "2.1"] {
         let out = dir.path().join(format!("h-{version}.bcfzip"));
         simulate(&model, &out, &["--bcf-version", version]);
+        validate_against_schemas(&out, version);
         let all: String = entries(&out).into_iter().map(|(_, t)| t).collect();
         assert!(all.contains("&lt;b&gt; &amp;"), "escaped in the XML");
         if let Some(read) = read_back(&out) {

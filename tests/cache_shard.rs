@@ -109,6 +109,34 @@ fn three_shards_of_a_generated_two_building_model_assemble_to_one_full_run() {
     shards_then_assemble(&generated_model(dir.path()), 3);
 }
 
+/// A generated block of two storeys, one unit each (8 walls over two levels).
+fn generated_block(dir: &Path) -> PathBuf {
+    let path = dir.join("block.ifc");
+    ok(&[
+        "synth",
+        "block",
+        "--blocks",
+        "1",
+        "--storeys",
+        "2",
+        "--grid",
+        "1x1",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    let plan: serde_json::Value =
+        serde_json::from_str(&ok(&["plan", path.to_str().unwrap(), "--json"])).unwrap();
+    let walls = plan["walls"].as_array().unwrap();
+    assert!(walls.len() >= 6, "{} walls", walls.len());
+    path
+}
+
+#[test]
+fn three_shards_of_a_generated_two_storey_block_assemble_to_one_full_run() {
+    let dir = tempfile::tempdir().unwrap();
+    shards_then_assemble(&generated_block(dir.path()), 3);
+}
+
 #[test]
 fn a_shard_is_checked() {
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm1.ifc");

@@ -6,10 +6,11 @@
 //! which enforces XML 1.0's character rules), the annotated IFC (our reader, and IfcOpenShell
 //! when installed), and the CSV of `rules run --out` (read again through `--facts`).
 
+mod common;
+
 use framewright::ifc::Model;
 use serde_json::Value;
 use std::collections::BTreeSet;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -184,16 +185,9 @@ fn bcf_documents_are_well_formed_xml_with_the_names() {
         s(&bcf),
         s(&model),
     ]));
-    let mut archive = zip::ZipArchive::new(std::fs::File::open(&bcf).unwrap()).unwrap();
     let mut titles = Vec::new();
-    for i in 0..archive.len() {
-        let mut entry = archive.by_index(i).unwrap();
-        let name = entry.name().unwrap().to_string();
-        if name.ends_with(".png") {
-            continue; // the snapshot image; bcf_export checks it
-        }
-        let mut text = String::new();
-        entry.read_to_string(&mut text).unwrap();
+    // The snapshot images are left out; bcf_export checks them.
+    for (name, text) in common::bcf::xml_documents(&bcf) {
         let doc = roxmltree::Document::parse(&text)
             .unwrap_or_else(|e| panic!("{name} is not well-formed XML: {e}"));
         titles.extend(
@@ -211,18 +205,6 @@ fn bcf_documents_are_well_formed_xml_with_the_names() {
             "{shown:?} in a topic title: {titles:?}"
         );
     }
-}
-
-/// `python3` when it imports ifcopenshell; otherwise None, after saying what is skipped.
-fn ifcopenshell() -> Option<&'static str> {
-    let ok = Command::new("python3")
-        .args(["-c", "import ifcopenshell"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        eprintln!("skipped: python3 with ifcopenshell is absent (pip install ifcopenshell)");
-    }
-    ok.then_some("python3")
 }
 
 #[test]
@@ -277,7 +259,9 @@ fn annotated_ifc_reads_back_with_the_names() {
         );
     }
 
-    let Some(python) = ifcopenshell() else { return };
+    let Some(python) = common::python::ifcopenshell() else {
+        return;
+    };
     let script = "import sys, json, ifcopenshell\nf = ifcopenshell.open(sys.argv[1])\n\
         print(json.dumps([t.Name for t in f.by_type('IfcTask')]))";
     let run = Command::new(python)

@@ -512,3 +512,39 @@ fn world_as_gltf_is_a_valid_static_scene_with_every_piece() {
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("-o FILE.glb"));
 }
+
+#[test]
+fn a_report_past_its_size_bound_is_refused_naming_the_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    let model = root().join("examples/models/tm1.ifc");
+    let run = |bound: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_framewright"))
+            .arg("simulate")
+            .arg(&model)
+            .args(["--no-cache", "--report"])
+            .arg(&out)
+            .env("FRAMEWRIGHT_MAX_REPORT_BYTES", bound)
+            .output()
+            .unwrap()
+    };
+    // TM1's page alone is larger than 10 kB.
+    let r = run("10000");
+    assert_eq!(r.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("FRAMEWRIGHT_MAX_REPORT_BYTES")
+            && err.contains("10000 bytes")
+            && err.contains("index.html"),
+        "{err}"
+    );
+    assert!(!out.exists(), "no report folder, not half of one");
+    let r = run("ten");
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("FRAMEWRIGHT_MAX_REPORT_BYTES=\"ten\""));
+    // A bound the report fits in.
+    assert!(run("100000000").status.success());
+    assert!(out.join("index.html").exists());
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "no temporary folder left");
+}

@@ -141,3 +141,107 @@ fn watch_redoes_changed_walls_on_saves_and_keeps_the_last_result_on_a_torn_save(
         "only the outputs, no temporary files: {left:?}"
     );
 }
+
+/// Every file of a report folder by name (the JSON without its cache counts).
+fn report_files(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let counts = regex::Regex::new(r#",\n    "cache": \{\n[^}]*\n    \}"#).unwrap();
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            let name = e.file_name().into_string().unwrap();
+            let mut bytes = std::fs::read(e.path()).unwrap();
+            if name == "simulate.json" {
+                let text = String::from_utf8(bytes).unwrap();
+                bytes = counts.replace(&text, "").into_owned().into_bytes();
+            }
+            (name, bytes)
+        })
+        .collect()
+}
+
+/// The report `simulate --report` writes for `model` without a cache.
+fn fresh_report(model: &Path, dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .arg("simulate")
+        .arg(model)
+        .args(["--no-cache", "--report"])
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    report_files(dir)
+}
+
+#[test]
+fn watch_rewrites_the_report_folder_on_every_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm1.ifc"),
+    )
+    .unwrap();
+    let model = dir.path().join("wall.ifc");
+    std::fs::write(&model, &original).unwrap();
+    let report = dir.path().join("report");
+    let child = Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .arg("watch")
+        .arg(&model)
+        .args(["--json", "--cache"])
+        .arg(dir.path().join("cache"))
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .arg("--report")
+        .arg(&report)
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut child = KillOnDrop(child);
+    let stdout = child.0.stdout.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+
+    next_event(&rx, "ready");
+    let first = report_files(&report);
+    assert_eq!(first, fresh_report(&model, &dir.path().join("expected-1")));
+
+    // A save renamed over the model: the report is the edited model's.
+    let edited = original.replace(STUD_AT, STUD_MOVED);
+    let tmp = dir.path().join("wall.ifc.tmp");
+    std::fs::write(&tmp, &edited).unwrap();
+    std::fs::rename(&tmp, &model).unwrap();
+    next_event(&rx, "regenerated");
+    let second = report_files(&report);
+    assert_ne!(second["index.html"], first["index.html"]);
+    assert_eq!(second, fresh_report(&model, &dir.path().join("expected-2")));
+
+    // The original saved in place: its wall and motion come from the cache, and the report
+    // is the first one again.
+    std::fs::write(&model, &original).unwrap();
+    let ev = next_event(&rx, "regenerated");
+    assert_eq!(ev["cache"]["cached"], 1, "{ev}");
+    assert_eq!(report_files(&report), first);
+
+    // Half a file: the report stays.
+    std::fs::write(&model, &edited[..edited.len() / 2]).unwrap();
+    let ev: serde_json::Value =
+        serde_json::from_str(&rx.recv_timeout(Duration::from_secs(120)).unwrap()).unwrap();
+    assert_eq!(ev["event"], "waiting", "{ev}");
+    assert_eq!(report_files(&report), first);
+
+    // Nothing left beside the report folder but the outputs.
+    let mut left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| !n.starts_with("expected-"))
+        .collect();
+    left.sort();
+    assert_eq!(left, ["cache", "out", "report", "wall.ifc"]);
+}

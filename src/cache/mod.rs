@@ -6,8 +6,12 @@ pub mod key;
 pub mod record_codec;
 pub mod sim;
 pub mod store;
+pub mod trace_codec;
 
-pub use sim::{CacheCounts, Shard, ShardRun, cached_simulation, simulate_cached, simulate_shard};
+pub use sim::{
+    CacheCounts, Need, Shard, ShardRun, cached_simulation, simulate_cached, simulate_cached_for,
+    simulate_shard,
+};
 pub use store::{Cache, CacheInfo, clear, info};
 
 /// The default cache folder: `$FRAMEWRIGHT_CACHE`, else `$XDG_CACHE_HOME/framewright`, else

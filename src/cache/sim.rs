@@ -120,6 +120,16 @@ fn prepare(
     })
 }
 
+/// What a cached run must hand back of each wall.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Need {
+    /// The record: verdicts, times, contacts (what `--json` and the rules read).
+    Records,
+    /// The record and the pose trace the report animates; a wall whose trace the cache lacks
+    /// is simulated again, and its trace stored.
+    Traces,
+}
+
 /// Simulates the model, reading and filling the cache.
 pub fn simulate_cached(
     model: &Model,
@@ -129,20 +139,43 @@ pub fn simulate_cached(
     cache: &Cache,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<(Simulation, CacheCounts), SimError> {
+    simulate_cached_for(
+        Need::Records,
+        model,
+        model_name,
+        cell,
+        options,
+        cache,
+        progress,
+    )
+}
+
+/// Simulates the model, reading and filling the cache, with what `need` asks of each wall.
+pub fn simulate_cached_for(
+    need: Need,
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    cache: &Cache,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<(Simulation, CacheCounts), SimError> {
     let prepared = prepare(model, model_name, cell, options)?;
-    let (found, misses, mut counts) = look_up(cache, &prepared.walls);
+    let (found, misses, mut counts) = look_up(cache, &prepared.walls, need);
     if found.iter().all(Option::is_none) {
         // Nothing cached: one plain run, whose result is the answer as it stands.
         let sim = simulate_with_progress(model, model_name, cell, options, progress)?;
         for record in &sim.records {
             if let Some((_, key)) = prepared.walls.iter().find(|(k, _)| k == &record.wall) {
-                cache.put_wall(key, record);
+                store(cache, key, record, need);
             }
         }
         counts.computed = sim.records.len();
         return Ok((sim, counts));
     }
-    let mut computed = simulate_misses(model, model_name, cell, options, cache, &misses, progress)?;
+    let mut computed = simulate_misses(
+        model, model_name, cell, options, cache, &misses, need, progress,
+    )?;
     counts.computed = computed.len();
     let mut records = Vec::with_capacity(found.len());
     for (record, (key_piece, _)) in found.into_iter().zip(&prepared.walls) {
@@ -170,7 +203,7 @@ pub fn cached_simulation(
     cache: &Cache,
 ) -> Result<Option<Simulation>, SimError> {
     let prepared = prepare(model, model_name, cell, options)?;
-    let (found, misses, _) = look_up(cache, &prepared.walls);
+    let (found, misses, _) = look_up(cache, &prepared.walls, Need::Records);
     if !misses.is_empty() {
         return Ok(None);
     }
@@ -222,9 +255,18 @@ pub fn simulate_shard(
         .filter(|(_, key)| shard.holds(key))
         .cloned()
         .collect();
-    let (_, misses, mut counts) = look_up(cache, &mine);
-    counts.computed =
-        simulate_misses(model, model_name, cell, options, cache, &misses, progress)?.len();
+    let (_, misses, mut counts) = look_up(cache, &mine, Need::Records);
+    counts.computed = simulate_misses(
+        model,
+        model_name,
+        cell,
+        options,
+        cache,
+        &misses,
+        Need::Records,
+        progress,
+    )?
+    .len();
     let wall_ids = mine
         .iter()
         .filter_map(|(k, _)| prepared.plan.walls.iter().find(|w| &w.key == k))
@@ -239,9 +281,11 @@ pub fn simulate_shard(
 }
 
 /// The cached record of each wall (None for a miss), the misses, and the counts so far.
+/// With `Need::Traces` a wall counts as cached only when its trace is there too.
 fn look_up(
     cache: &Cache,
     walls: &[(String, String)],
+    need: Need,
 ) -> (Vec<Option<WallRecord>>, Vec<(String, String)>, CacheCounts) {
     let mut counts = CacheCounts::default();
     let mut found = Vec::with_capacity(walls.len());
@@ -250,8 +294,19 @@ fn look_up(
         match cache.get_wall(key) {
             // An entry names its wall; one for another wall with equal inputs is not reused.
             Lookup::Hit(r) if &r.wall == key_piece => {
+                let mut record = *r;
+                if need == Need::Traces {
+                    match cache.get_trace(key) {
+                        Some(trace) => record.trace = trace,
+                        None => {
+                            found.push(None);
+                            misses.push((key_piece.clone(), key.clone()));
+                            continue;
+                        }
+                    }
+                }
                 counts.cached += 1;
-                found.push(Some(*r));
+                found.push(Some(record));
                 continue;
             }
             Lookup::Hit(_) | Lookup::Miss => {}
@@ -263,7 +318,16 @@ fn look_up(
     (found, misses, counts)
 }
 
+/// Stores what a run needs of a wall: its record, and with `Need::Traces` its trace.
+fn store(cache: &Cache, key: &str, record: &WallRecord, need: Need) {
+    cache.put_wall(key, record);
+    if need == Need::Traces {
+        cache.put_trace(key, &record.trace);
+    }
+}
+
 /// Simulates the missing walls (in one run) and stores their records.
+#[allow(clippy::too_many_arguments)]
 fn simulate_misses(
     model: &Model,
     model_name: &str,
@@ -271,6 +335,7 @@ fn simulate_misses(
     options: &SimOptions,
     cache: &Cache,
     misses: &[(String, String)],
+    need: Need,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<Vec<WallRecord>, SimError> {
     if misses.is_empty() {
@@ -283,7 +348,7 @@ fn simulate_misses(
     let records = simulate_with_progress(model, model_name, cell, &only, progress)?.records;
     for r in &records {
         if let Some((_, key)) = misses.iter().find(|(k, _)| k == &r.wall) {
-            cache.put_wall(key, r);
+            store(cache, key, r, need);
         }
     }
     Ok(records)

@@ -4,7 +4,9 @@
 //! A folder that cannot be written (read-only, full disk) turns writing off with one warning.
 
 use super::record_codec::Entry;
+use super::trace_codec;
 use crate::sim::WallRecord;
+use crate::sim::record::PoseTrace;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -51,6 +53,11 @@ impl Cache {
             .join(format!("{key}.json"))
     }
 
+    /// A wall's pose trace sits beside its record, under the same key.
+    fn trace_path(&self, key: &str) -> PathBuf {
+        self.wall_path(key).with_extension("trace")
+    }
+
     pub fn get_wall(&self, key: &str) -> Lookup {
         let Ok(bytes) = std::fs::read(self.wall_path(key)) else {
             return Lookup::Miss;
@@ -64,13 +71,31 @@ impl Cache {
         }
     }
 
+    /// A wall's pose trace: None when absent, torn, altered or of another key or format.
+    pub fn get_trace(&self, key: &str) -> Option<PoseTrace> {
+        let bytes = std::fs::read(self.trace_path(key)).ok()?;
+        trace_codec::decode(key, &bytes)
+    }
+
     /// Stores a wall's record; a failure turns writing off for this run and leaves a warning.
     pub fn put_wall(&self, key: &str, record: &WallRecord) {
+        self.put(&self.wall_path(key), |w| {
+            serde_json::to_writer(w, &Entry::new(key, record)).map_err(std::io::Error::other)
+        });
+    }
+
+    /// Stores a wall's pose trace (for the report's animation), like `put_wall`.
+    pub fn put_trace(&self, key: &str, trace: &PoseTrace) {
+        if let Some(bytes) = trace_codec::encode(key, trace) {
+            self.put(&self.trace_path(key), |w| w.write_all(&bytes));
+        }
+    }
+
+    fn put(&self, path: &Path, write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>) {
         if self.write_failed.load(Ordering::Relaxed) {
             return;
         }
-        let path = self.wall_path(key);
-        if let Err(e) = write_atomically(&path, &Entry::new(key, record))
+        if let Err(e) = write_atomically(path, write)
             && !self.write_failed.swap(true, Ordering::Relaxed)
             && let Ok(mut w) = self.warning.lock()
         {
@@ -88,14 +113,15 @@ impl Cache {
     }
 }
 
-fn write_atomically(path: &Path, entry: &impl Serialize) -> std::io::Result<()> {
+fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let dir = path
         .parent()
         .ok_or_else(|| std::io::Error::other("an entry path has no folder"))?;
     std::fs::create_dir_all(dir)?;
-    crate::atomic::write_atomically_with(path, |w| {
-        serde_json::to_writer(w, entry).map_err(std::io::Error::other)
-    })
+    crate::atomic::write_atomically_with(path, |w| write(w))
 }
 
 /// What a cache folder holds.
@@ -104,6 +130,8 @@ pub struct CacheInfo {
     pub dir: PathBuf,
     /// Simulated walls (`simulate`, `plan`, `diff`, `watch`).
     pub walls: u64,
+    /// Pose traces of cached walls (kept for `simulate --report`).
+    pub traces: u64,
     /// Walls simulated for `why`.
     pub why_walls: u64,
     pub bytes: u64,
@@ -120,6 +148,7 @@ pub fn info(dir: &Path) -> std::io::Result<CacheInfo> {
         info.bytes += bytes;
         match file.kind {
             Kind::Wall => info.walls += 1,
+            Kind::Trace => info.traces += 1,
             Kind::Why => info.why_walls += 1,
         }
     }
@@ -148,6 +177,7 @@ pub fn clear(dir: &Path) -> std::io::Result<u64> {
 
 enum Kind {
     Wall,
+    Trace,
     Why,
 }
 
@@ -183,12 +213,19 @@ fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
             };
             for e in entries.flatten() {
                 let name = e.file_name().to_string_lossy().into_owned();
-                if name.ends_with(".json") || (name.starts_with('.') && name.ends_with(".tmp")) {
-                    files.push(EntryFile {
-                        path: e.path(),
-                        kind: Kind::Wall,
-                    });
-                }
+                let kind = if name.ends_with(".trace") {
+                    Kind::Trace
+                } else if name.ends_with(".json")
+                    || (name.starts_with('.') && name.ends_with(".tmp"))
+                {
+                    Kind::Wall
+                } else {
+                    continue;
+                };
+                files.push(EntryFile {
+                    path: e.path(),
+                    kind,
+                });
             }
         }
     }

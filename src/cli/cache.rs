@@ -84,9 +84,11 @@ pub fn run(cmd: CacheCommand) -> CmdResult {
                 print_stdout(&format!("{text}\n"))
             } else {
                 print_stdout(&format!(
-                    "{}\n{} simulated walls, {} walls simulated for `why`, {:.1} MB\n",
+                    "{}\n{} simulated walls ({} with the motion for reports), {} walls simulated \
+                     for `why`, {:.1} MB\n",
                     info.dir.display(),
                     info.walls,
+                    info.traces,
                     info.why_walls,
                     info.bytes as f64 / 1e6
                 ))

@@ -4,7 +4,7 @@
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::load_cell;
 use super::{CmdResult, Failure, print_stdout, write_stdout};
-use framewright::cache::{Shard, simulate_cached, simulate_shard};
+use framewright::cache::{Need, Shard, simulate_cached_for, simulate_shard};
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::report::html::{ReportInput, write_report};
@@ -93,11 +93,12 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     );
     let bars = Bars::new();
     let progress = |wall: &str, done, total| bars.update(wall, done, total);
-    // The report animates every wall from its pose trace, which the cache does not keep.
-    let cache = if args.report.is_some() {
-        None
+    let cache = args.cache.open();
+    // The report animates every wall from its pose trace: the cache must hand those back too.
+    let need = if args.report.is_some() {
+        Need::Traces
     } else {
-        args.cache.open()
+        Need::Records
     };
     if let Some(shard) = args.shard {
         let Some(cache) = &cache else {
@@ -112,7 +113,8 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     }
     let (sim, counts) = match &cache {
         Some(cache) => {
-            let (sim, counts) = simulate_cached(&model, &name, &cell, &options, cache, &progress)?;
+            let (sim, counts) =
+                simulate_cached_for(need, &model, &name, &cell, &options, cache, &progress)?;
             (sim, Some(counts))
         }
         None => (

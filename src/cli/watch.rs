@@ -1,17 +1,19 @@
-//! `framewright watch MODEL [--cell C] [--rules F]… [--json] [--out DIR]`: simulates the model,
-//! then waits for saves and simulates again, redoing only the walls whose inputs changed (the
-//! rest come from the cache). Each regeneration rewrites DIR/simulate.json and
-//! DIR/simulate.txt atomically and prints what changed; a file that does not read (a save in
-//! progress, a broken edit) keeps the last results and says why. Ctrl-C ends it.
+//! `framewright watch MODEL [--cell C] [--rules F]… [--json] [--out DIR] [--report DIR]`:
+//! simulates the model, then waits for saves and simulates again, redoing only the walls whose
+//! inputs changed (the rest come from the cache). Each regeneration rewrites DIR/simulate.json
+//! and DIR/simulate.txt atomically (and with `--report` the report folder, replaced whole) and
+//! prints what changed; a file that does not read (a save in progress, a broken edit) keeps the
+//! last results and says why. Ctrl-C ends it.
 
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::diff::{file_name, simulate_defaults};
 use super::{CmdResult, Failure};
-use framewright::cache::{Cache, CacheCounts, simulate_cached};
+use framewright::cache::{Cache, CacheCounts, Need, simulate_cached_for};
 use framewright::cell::Cell;
 use framewright::diff::{ModelDiff, Version, diff};
 use framewright::frame::plan::Plan;
 use framewright::ifc::Model;
+use framewright::report::html::{ReportInput, write_report};
 use framewright::report::simulate::SimReport;
 use framewright::sim::simulate;
 use framewright::user_rules::UserRules;
@@ -42,6 +44,10 @@ pub struct WatchArgs {
     /// Where to write simulate.json and simulate.txt (default: MODEL.framewright/ beside it).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Also rewrite a report folder (as `simulate --report`) on every regeneration; the
+    /// folder is built beside DIR and swapped in whole.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
     #[command(flatten)]
     pub cache: CacheArgs,
 }
@@ -268,11 +274,24 @@ impl Watch {
     fn simulate(&self, model: &Model) -> Result<(Plan, SimReport, Option<CacheCounts>), String> {
         let options = simulate_defaults();
         let name = file_name(&self.args.model);
+        // The report animates every wall: its pose traces must come back from the cache too.
+        let need = if self.args.report.is_some() {
+            Need::Traces
+        } else {
+            Need::Records
+        };
         let (sim, counts) = match &self.cache {
             Some(cache) => {
-                let (sim, counts) =
-                    simulate_cached(model, &name, &self.cell, &options, cache, &|_, _, _| {})
-                        .map_err(|e| e.to_string())?;
+                let (sim, counts) = simulate_cached_for(
+                    need,
+                    model,
+                    &name,
+                    &self.cell,
+                    &options,
+                    cache,
+                    &|_, _, _| {},
+                )
+                .map_err(|e| e.to_string())?;
                 (sim, Some(counts))
             }
             None => (
@@ -294,6 +313,17 @@ impl Watch {
         report.write_json(&mut json).map_err(|e| e.to_string())?;
         write_atomically(&self.out.join("simulate.json"), &json)?;
         write_atomically(&self.out.join("simulate.txt"), report.to_text().as_bytes())?;
+        if let Some(dir) = &self.args.report {
+            let input = ReportInput {
+                model,
+                model_name: &name,
+                cell: &self.cell,
+                sim: &sim,
+                report: &report,
+            };
+            write_report(dir, &input)
+                .map_err(|e| format!("{}: cannot write the report: {e}", dir.display()))?;
+        }
         Ok((sim.plan, report, counts))
     }
 }

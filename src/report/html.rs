@@ -47,8 +47,48 @@ pub struct ReportInput<'a> {
     pub report: &'a SimReport,
 }
 
+/// The environment variable that bounds a report's size in bytes (all its files are built in
+/// memory before the folder is swapped in, so this bounds the memory the report takes too).
+pub const ENV_MAX_REPORT_BYTES: &str = "FRAMEWRIGHT_MAX_REPORT_BYTES";
+/// The default bound: 2 GiB (a 150-wall building's report is about 200 MB).
+pub const DEFAULT_MAX_REPORT_BYTES: u64 = 2 << 30;
+
+/// The report size bound in force: `FRAMEWRIGHT_MAX_REPORT_BYTES` or the default.
+pub fn max_report_bytes() -> std::io::Result<u64> {
+    match std::env::var(ENV_MAX_REPORT_BYTES) {
+        Ok(v) => v.trim().parse::<u64>().map_err(|_| {
+            std::io::Error::other(format!(
+                "{ENV_MAX_REPORT_BYTES}={v:?} is not a whole number of bytes"
+            ))
+        }),
+        Err(_) => Ok(DEFAULT_MAX_REPORT_BYTES),
+    }
+}
+
 /// The files of a report, by name in the report folder, in writing order.
 pub fn report_files(input: &ReportInput) -> Vec<(String, Vec<u8>)> {
+    // Without a bound nothing is refused.
+    report_files_within(input, u64::MAX).unwrap_or_default()
+}
+
+/// The files of a report, refused as soon as they add up to more than `max_bytes`.
+pub fn report_files_within(
+    input: &ReportInput,
+    max_bytes: u64,
+) -> std::io::Result<Vec<(String, Vec<u8>)>> {
+    let mut total = 0u64;
+    let mut check = |name: &str, bytes: &[u8]| -> std::io::Result<()> {
+        total = total.saturating_add(bytes.len() as u64);
+        if total > max_bytes {
+            return Err(std::io::Error::other(format!(
+                "the report grows past its bound of {max_bytes} bytes at {name} \
+                 ({ENV_MAX_REPORT_BYTES}); raise the bound (e.g. {ENV_MAX_REPORT_BYTES}={}) \
+                 or report fewer walls with --wall",
+                max_bytes.saturating_mul(2)
+            )));
+        }
+        Ok(())
+    };
     let walls: Vec<WallView> = input
         .report
         .walls
@@ -79,10 +119,9 @@ pub fn report_files(input: &ReportInput) -> Vec<(String, Vec<u8>)> {
             (validation(input.report))
         },
     );
-    files.push((
-        "index.html".to_string(),
-        replace_forbidden(index.into_string()).into_bytes(),
-    ));
+    let index = replace_forbidden(index.into_string()).into_bytes();
+    check("index.html", &index)?;
+    files.push(("index.html".to_string(), index));
     if split {
         for (i, w) in walls.iter().enumerate() {
             let body = html! {
@@ -91,22 +130,23 @@ pub fn report_files(input: &ReportInput) -> Vec<(String, Vec<u8>)> {
                 (wall_section(input, w, &scene_name(i)))
             };
             let title = format!("{} — simulation report", w.row.name);
-            files.push((
-                page_name(i),
-                replace_forbidden(page(input, &title, body).into_string()).into_bytes(),
-            ));
+            let bytes = replace_forbidden(page(input, &title, body).into_string()).into_bytes();
+            check(&page_name(i), &bytes)?;
+            files.push((page_name(i), bytes));
         }
     }
     for (i, w) in walls.iter().enumerate() {
         if let Some(bytes) = glb::wall_glb(input.cell, input.sim, input.report, &w.record.wall) {
+            check(&scene_name(i), &bytes)?;
             files.push((scene_name(i), bytes));
         }
     }
     let mut json = Vec::new();
     if input.report.write_json(&mut json).is_ok() {
+        check("simulate.json", &json)?;
         files.push(("simulate.json".to_string(), json));
     }
-    files
+    Ok(files)
 }
 
 fn page(input: &ReportInput, title: &str, body: Markup) -> Markup {
@@ -272,10 +312,23 @@ fn validation(report: &SimReport) -> Markup {
     }
 }
 
+/// Swaps two folders in one step, so a reader of `b` sees the old report or the new one,
+/// never none (Linux's renameat2 with RENAME_EXCHANGE).
+#[cfg(target_os = "linux")]
+fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
+    use rustix::fs::{CWD, RenameFlags, renameat_with};
+    renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE).map_err(std::io::Error::from)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
+    Err(std::io::Error::from(std::io::ErrorKind::Unsupported))
+}
+
 /// Writes the report's files into `dir`: built in a fresh temporary folder beside it, then
-/// renamed into place (an existing `dir` is replaced only once the new one is complete).
+/// swapped into place (an existing `dir` is replaced only once the new one is complete).
 pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
-    let files = report_files(input);
+    let files = report_files_within(input, max_report_bytes()?)?;
     let parent = match dir.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -304,6 +357,11 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
                     "the folder exists and holds no earlier report; name a new folder",
                 ));
             }
+            if exchange(&tmp, dir).is_ok() {
+                // `dir` is the new report at once; `tmp` now holds the earlier one.
+                return std::fs::remove_dir_all(&tmp);
+            }
+            // Where the filesystem cannot exchange two folders, `dir` is briefly absent.
             std::fs::rename(dir, &old)?;
             std::fs::rename(&tmp, dir)?;
             std::fs::remove_dir_all(&old)

@@ -1,5 +1,10 @@
 //! Shared by the integration tests: the test data in `../shared` beside the checkout, which
-//! a test uses when present and skips (saying so) when absent.
+//! a test uses when present and skips (saying so) when absent; reading BCF archives back; the
+//! Python oracles.
+#![allow(dead_code)]
+
+pub mod bcf;
+pub mod python;
 
 use std::path::{Path, PathBuf};
 

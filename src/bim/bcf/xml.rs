@@ -99,7 +99,12 @@ pub fn markup(v: BcfVersion, header: &BcfHeader, t: &IssueTopic) -> io::Result<V
                     if let Some(p) = &header.project_global_id {
                         el = el.with_attribute(("IfcProject", p.as_str()));
                     }
-                    el.with_attribute(("IsExternal", "true"))
+                    // BCF 2.1 spells the attribute with a small i; 3.0 with a capital.
+                    let external = match v {
+                        BcfVersion::V3_0 => "IsExternal",
+                        BcfVersion::V2_1 => "isExternal",
+                    };
+                    el.with_attribute((external, "true"))
                         .write_inner_content(|w| {
                             text(w, "Filename", &header.model_file)?;
                             text(w, "Date", &header.date)
