@@ -1,10 +1,10 @@
 //! Simulated seconds per wall-clock second, event-driven against fixed steps, measured in the
 //! same run: every wall of the bundled test model 3 (framing and nailing) on the study's ABB
-//! cell, then, with FRAMEWRIGHT_BENCH_3STOREY=1 (it takes minutes) and when
-//! ../shared/ifc-testcases/g_scale_3storey.ifc is present, the 3-storey model's 153 walls.
-//! The fixed-step run of the 3-storey model covers every 7th wall (the event-driven run of
-//! the same walls gives the ratio) unless FRAMEWRIGHT_BENCH_FIXED_ALL=1. The figures are
-//! printed once; criterion then times the event-driven TM3 run.
+//! cell, then (when ../shared/ifc-testcases/g_scale_3storey.ifc is present) the 3-storey
+//! model's 153 walls. The fixed-step run of the 3-storey model takes minutes: it covers every
+//! 7th wall (the event-driven run of the same walls gives the ratio) unless
+//! FRAMEWRIGHT_BENCH_FIXED_ALL=1. The figures are printed once; criterion then times the
+//! event-driven TM3 run.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use framewright::cell::Cell;
@@ -54,9 +54,7 @@ fn bench(c: &mut Criterion) {
 
     let storeys =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/ifc-testcases/g_scale_3storey.ifc");
-    if std::env::var_os("FRAMEWRIGHT_BENCH_3STOREY").is_none() {
-        println!("3-storey figures skipped: set FRAMEWRIGHT_BENCH_3STOREY=1 (minutes)");
-    } else if storeys.exists() {
+    if storeys.exists() {
         let model = Model::open(&storeys).expect("3-storey model");
         let all = measure(&model, &cell, &[], Stepping::Events);
         println!(

@@ -45,9 +45,6 @@ const TRANSFER_STEP: f64 = 0.002;
 const RAIL_SIZE: [f64; 2] = [0.01, 0.03];
 /// How far in front of the end stop the sensor zone reaches.
 const SENSOR_REACH: f64 = 0.005;
-/// A piece rides its belt while its speed differs from the belt's by less than this fraction
-/// of the belt speed.
-const RIDE_TOLERANCE: f64 = 0.01;
 /// Finger plate thickness of a parallel gripper's jaws.
 pub const FINGER: f64 = 0.010;
 
@@ -121,24 +118,6 @@ pub struct Physics {
     /// gripped, released, clamped, nailed; jaws; belts): a clearance measured at one count
     /// holds only at that count.
     generation: u64,
-    /// Lumber riding a running belt without the solver (event-driven stepping).
-    ride: Ride,
-}
-
-/// Lumber carried by a running belt, advanced analytically (belt velocity × time) while the
-/// solver pauses: each rider touches only its belt and moves at the belt's surface velocity,
-/// so nothing but the belt acts on it until it comes near something else or the belt's end.
-#[derive(Debug, Default)]
-struct Ride {
-    active: bool,
-    /// Rider → its belt's surface velocity (cell frame, m/s).
-    riders: BTreeMap<String, Vector3<f64>>,
-    /// Simulated time since the riders' bodies were last placed (s).
-    elapsed: f64,
-    /// How long the ride may last before a rider comes within the margin of anything (s).
-    horizon: f64,
-    /// The fastest rider's speed (m/s).
-    speed: f64,
 }
 
 /// How far the robot, its tool and a held piece are from the rest of the world (m), each
@@ -393,13 +372,12 @@ impl Physics {
             lumber_of: HashMap::new(),
             cell: cell.clone(),
             generation: 0,
-            ride: Ride::default(),
         }
     }
 
     /// Puts a lumber piece into the world at `pose` (cell frame), at rest.
     pub fn add_lumber(&mut self, piece: &ScenePiece, pose: &Isometry3<f64>) {
-        self.change();
+        self.generation += 1;
         let [l, w, t] = piece.size.map(|v| v as f32 / 2.0);
         // Lumber on a belt never sleeps: the slow infeed belt moves it below rapier's sleep
         // threshold. Placed pieces may sleep again (see `detach`).
@@ -426,17 +404,16 @@ impl Physics {
 
     /// Takes a piece out of the world (an operator lifts it off the belt).
     pub fn remove_lumber(&mut self, id: &str) {
-        self.change();
+        self.generation += 1;
         if let Some(b) = self.lumber.remove(id) {
             self.world.remove_body_with_colliders(b.body, true);
             self.lumber_of.remove(&b.collider);
         }
     }
 
-    /// A piece's pose (where a riding piece is now, not where its body was last placed).
     pub fn lumber_pose(&self, id: &str) -> Option<Isometry3<f64>> {
         let b = self.lumber.get(id)?;
-        Some(self.ridden(id, to_iso(self.world.bodies[b.body].position())))
+        Some(to_iso(self.world.bodies[b.body].position()))
     }
 
     /// Linear (m/s) and angular (rad/s) speed of a piece.
@@ -469,7 +446,7 @@ impl Physics {
     /// A framing table under the wall when the cell's assembly surface is above the floor:
     /// a solid block from the floor to `top` over the cell-frame rectangle `min`..`max`.
     pub fn add_assembly_table(&mut self, min: [f64; 2], max: [f64; 2], top: f64) {
-        self.change();
+        self.generation += 1;
         let floor = self.cell.floor.z;
         let height = top - floor;
         if height <= 0.0 {
@@ -494,7 +471,7 @@ impl Physics {
 
     /// Opens the jaws (`None`) or closes them on lumber of this thickness.
     pub fn set_jaws(&mut self, closed_on: Option<f64>) {
-        self.change();
+        self.generation += 1;
         let open = self
             .cell
             .tool
@@ -511,7 +488,7 @@ impl Physics {
 
     /// Holds a piece rigidly in the gripper: it becomes position-driven (it follows the tool).
     pub fn attach(&mut self, id: &str) {
-        self.change();
+        self.generation += 1;
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::KinematicPositionBased, true);
         }
@@ -519,7 +496,7 @@ impl Physics {
 
     /// Lets go of a piece: it is a dynamic body again, at rest where it is.
     pub fn detach(&mut self, id: &str) {
-        self.change();
+        self.generation += 1;
         if let Some(b) = self.lumber.get(id) {
             let body = &mut self.world.bodies[b.body];
             body.set_body_type(RigidBodyType::Dynamic, true);
@@ -536,7 +513,7 @@ impl Physics {
     /// The fixture holds a placed piece where it came to rest (a framing table's stops and
     /// clamps): it no longer moves, whatever touches it later.
     pub fn clamp(&mut self, id: &str) {
-        self.change();
+        self.generation += 1;
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::Fixed, true);
         }
@@ -551,7 +528,7 @@ impl Physics {
 
     /// Joins two pieces where they are (a nail).
     pub fn nail(&mut self, a: &str, b: &str) {
-        self.change();
+        self.generation += 1;
         let (Some(a), Some(b)) = (self.lumber.get(a).copied(), self.lumber.get(b).copied()) else {
             return;
         };
@@ -566,7 +543,7 @@ impl Physics {
 
     /// Starts or stops both belts; a started belt wakes the lumber on it.
     pub fn set_belts(&mut self, running: bool) {
-        self.change();
+        self.generation += 1;
         if running && !self.belts.running {
             let bodies: Vec<RigidBodyHandle> = self.lumber.values().map(|b| b.body).collect();
             for b in bodies {
@@ -578,282 +555,12 @@ impl Physics {
 
     /// One physics step.
     pub fn step(&mut self) {
-        self.end_ride();
         self.world.step_with_events(&self.belts, &());
     }
 
     /// The count of changes to the world's contents (see `generation`).
     pub fn generation(&self) -> u64 {
         self.generation
-    }
-
-    /// A change to what is in the world or how it may move: riders are placed first.
-    fn change(&mut self) {
-        self.end_ride();
-        self.generation += 1;
-    }
-
-    /// The surface velocity of a belt collider while the belts run (cell frame, m/s).
-    fn belt_velocity(&self, c: ColliderHandle) -> Option<Vector3<f64>> {
-        if !self.belts.running {
-            return None;
-        }
-        self.belts.belts.iter().find(|b| b.0 == c).map(|(_, d, v)| {
-            Vector3::new(f64::from(d.x), f64::from(d.y), f64::from(d.z)) * f64::from(*v)
-        })
-    }
-
-    /// The belt a piece rides and its velocity: the piece touches that running belt and
-    /// nothing else, moves at the belt's surface velocity (within `linear`, m/s) and does not
-    /// turn (below `angular`, rad/s).
-    fn riding_on(
-        &self,
-        b: &LumberBody,
-        linear: f64,
-        angular: f64,
-    ) -> Option<(ColliderHandle, Vector3<f64>)> {
-        let body = &self.world.bodies[b.body];
-        if !body.is_dynamic() || f64::from(body.angvel().length()) >= angular {
-            return None;
-        }
-        let mut belt = None;
-        for pair in self.world.contact_pairs_with(b.collider) {
-            if !pair.has_any_active_contact() {
-                continue;
-            }
-            let other = if pair.collider1 == b.collider {
-                pair.collider2
-            } else {
-                pair.collider1
-            };
-            let v = self.belt_velocity(other)?;
-            if belt.is_some_and(|(c, _)| c != other) {
-                return None;
-            }
-            belt = Some((other, v));
-        }
-        let (c, v) = belt?;
-        let l = body.linvel();
-        let actual = Vector3::new(f64::from(l.x), f64::from(l.y), f64::from(l.z));
-        let tolerance = linear.max(RIDE_TOLERANCE * v.norm());
-        ((actual - v).norm() < tolerance).then_some((c, v))
-    }
-
-    /// Whether every loose piece is at rest (below `linear` m/s and `angular` rad/s) or rides
-    /// a running belt steadily (see `riding_on`, with the belt speed's RIDE_TOLERANCE).
-    pub fn lumber_steady(&self, linear: f64, angular: f64) -> bool {
-        self.lumber.values().all(|b| {
-            let body = &self.world.bodies[b.body];
-            !body.is_dynamic()
-                || (f64::from(body.linvel().length()) < linear
-                    && f64::from(body.angvel().length()) < angular)
-                || self.riding_on(b, linear.max(1e-3), angular).is_some()
-        })
-    }
-
-    /// Starts a ride: the pieces riding a running belt (see `riding_on`) are from now on
-    /// advanced analytically. Returns how long they may ride (s): until the first of them comes
-    /// within `margin` of anything but its own belt and the pieces riding along with it, or of
-    /// its belt's downstream end (distances looked for up to `reach`, m).
-    pub fn start_ride(&mut self, linear: f64, angular: f64, reach: f64, margin: f64) -> f64 {
-        self.end_ride();
-        let mut riders: BTreeMap<String, (ColliderHandle, Vector3<f64>)> = BTreeMap::new();
-        for (id, b) in &self.lumber {
-            if let Some(r) = self.riding_on(b, linear.max(1e-3), angular) {
-                riders.insert(id.clone(), r);
-            }
-        }
-        let mut horizon = f64::INFINITY;
-        for (id, (belt, v)) in &riders {
-            let speed = v.norm();
-            if speed <= 0.0 {
-                continue;
-            }
-            let room = self.ride_room(id, *belt, v, &riders, reach) - margin;
-            horizon = horizon.min((room / speed).max(0.0));
-        }
-        self.ride = Ride {
-            active: true,
-            speed: riders.values().map(|(_, v)| v.norm()).fold(0.0, f64::max),
-            riders: riders.into_iter().map(|(id, (_, v))| (id, v)).collect(),
-            elapsed: 0.0,
-            horizon,
-        };
-        horizon
-    }
-
-    /// How far a rider can travel (m): to its belt's downstream end, and to the nearest body
-    /// other than its belt, the robot (watched by the executor) and the pieces riding with it.
-    fn ride_room(
-        &self,
-        id: &str,
-        belt: ColliderHandle,
-        v: &Vector3<f64>,
-        riders: &BTreeMap<String, (ColliderHandle, Vector3<f64>)>,
-        reach: f64,
-    ) -> f64 {
-        let Some(b) = self.lumber.get(id) else {
-            return 0.0;
-        };
-        let direction = v.normalize();
-        let collider = &self.world.colliders[b.collider];
-        let belt_collider = &self.world.colliders[belt];
-        let (Some(piece), Some(slab)) = (
-            collider.shape().as_cuboid(),
-            belt_collider.shape().as_cuboid(),
-        ) else {
-            return 0.0;
-        };
-        // The belt's end: its half length along the travel against the piece's furthest point.
-        let extent = |pose: &Pose, half: Vector| -> (f64, f64) {
-            let iso = to_iso(pose);
-            let local = iso.rotation.inverse() * direction;
-            let h = half;
-            let along = local.x.abs() * f64::from(h.x)
-                + local.y.abs() * f64::from(h.y)
-                + local.z.abs() * f64::from(h.z);
-            (iso.translation.vector.dot(&direction), along)
-        };
-        let (piece_centre, piece_half) = extent(collider.position(), piece.half_extents);
-        let (belt_centre, belt_half) = extent(belt_collider.position(), slab.half_extents);
-        let room = (belt_centre + belt_half) - (piece_centre + piece_half);
-        // Everything else within reach.
-        let companions: Vec<ColliderHandle> = riders
-            .iter()
-            .filter(|(other, (_, w))| *other != id && (w - v).norm() < 1e-12)
-            .filter_map(|(other, _)| self.lumber.get(other).map(|o| o.collider))
-            .collect();
-        let predicate = |h: ColliderHandle, c: &Collider| {
-            h != b.collider
-                && h != belt
-                && !c.is_sensor()
-                && !companions.contains(&h)
-                && !self.robot_colliders.contains(&h)
-        };
-        let (grown, centre) = grown_box(collider.shape(), reach);
-        let pose = *collider.position();
-        let filter = QueryFilter::default().predicate(&predicate);
-        let mut nearest = reach;
-        for (_, other) in self.world.intersect_shape(pose * centre, &grown, filter) {
-            let d = rapier3d::parry::query::distance(
-                &pose,
-                collider.shape(),
-                other.position(),
-                other.shape(),
-            )
-            .map_or(0.0, |d| f64::from(d.distance));
-            nearest = nearest.min(d);
-        }
-        room.min(nearest)
-    }
-
-    /// Whether a ride is on.
-    pub fn riding(&self) -> bool {
-        self.ride.active
-    }
-
-    /// How much longer the ride may last (s); infinite without a ride.
-    pub fn ride_left(&self) -> f64 {
-        if self.ride.active {
-            self.ride.horizon - self.ride.elapsed
-        } else {
-            f64::INFINITY
-        }
-    }
-
-    /// Simulated time since the riders' bodies were placed (s), 0 without a ride.
-    pub fn ride_elapsed(&self) -> f64 {
-        if self.ride.active {
-            self.ride.elapsed
-        } else {
-            0.0
-        }
-    }
-
-    /// The fastest rider's speed (m/s), 0 without riders.
-    pub fn ride_speed(&self) -> f64 {
-        self.ride.speed
-    }
-
-    /// A rider's velocity (m/s), if the piece rides.
-    pub fn rider_velocity(&self, id: &str) -> Option<Vector3<f64>> {
-        self.ride
-            .riders
-            .get(id)
-            .copied()
-            .filter(|_| self.ride.active)
-    }
-
-    /// Advances the riders by `dt` (s) of belt travel.
-    pub fn ride_on(&mut self, dt: f64) {
-        if self.ride.active {
-            self.ride.elapsed += dt;
-        }
-    }
-
-    /// Ends a ride: every rider's body is placed where the belt has carried it, still moving
-    /// with the belt, and contacts and scene queries are brought up to date.
-    pub fn end_ride(&mut self) {
-        if !self.ride.active {
-            return;
-        }
-        let ride = std::mem::take(&mut self.ride);
-        if ride.riders.is_empty() || ride.elapsed <= 0.0 {
-            return;
-        }
-        for (id, v) in &ride.riders {
-            let Some(b) = self.lumber.get(id) else {
-                continue;
-            };
-            let body = &mut self.world.bodies[b.body];
-            let mut pose = to_iso(body.position());
-            pose.translation.vector += v * ride.elapsed;
-            body.set_position(to_pose(&pose), true);
-        }
-        self.world.detect_collisions(&self.belts, &());
-    }
-
-    /// A piece's pose moved by the ride so far, if it rides.
-    fn ridden(&self, id: &str, mut pose: Isometry3<f64>) -> Isometry3<f64> {
-        if self.ride.active
-            && let Some(v) = self.ride.riders.get(id)
-        {
-            pose.translation.vector += v * self.ride.elapsed;
-        }
-        pose
-    }
-
-    /// Per joint value, how far (m) any point of the robot's moving colliders and the held
-    /// piece at joints `q` moves per unit of that joint's change: its furthest bounding-box
-    /// corner's distance from the joint's axis (1 for a sliding joint). Changing the joints
-    /// from the base outwards, each joint turns its axis and everything beyond it together,
-    /// so a move from `q` to `q'` moves no point further than the sum of |q'ᵢ − qᵢ| × this.
-    pub fn joint_reach(&self, q: &[f64], held: Option<(&str, &Isometry3<f64>)>) -> Vec<f64> {
-        let corners = self.robot_corners(q, held);
-        let poses = self.cell.robot.fk_all(q);
-        let mut reach = vec![0.0; q.len()];
-        for joint in &self.cell.robot.joints {
-            let Some(i) = joint.dof_index else {
-                continue;
-            };
-            reach[i] = match joint.kind {
-                crate::cell::JointKind::Prismatic => 1.0,
-                crate::cell::JointKind::Fixed => 0.0,
-                _ => {
-                    let frame = self.cell.robot_base * poses[joint.child];
-                    let origin = frame.translation.vector;
-                    let axis = frame.rotation * joint.axis.into_inner();
-                    corners
-                        .iter()
-                        .map(|c| {
-                            let r = c - origin;
-                            (r - axis * r.dot(&axis)).norm()
-                        })
-                        .fold(0.0, f64::max)
-                }
-            };
-        }
-        reach
     }
 
     /// Puts the robot's bodies (and the held piece, at `in_tool` in tool0) at joint values
@@ -876,8 +583,17 @@ impl Physics {
     /// Updates the contacts for where the bodies are now, without advancing time (no solver,
     /// nothing moves).
     pub fn detect(&mut self) {
-        self.end_ride();
         self.world.detect_collisions(&self.belts, &());
+    }
+
+    /// Whether every dynamic lumber body moves slower than `linear` (m/s) and `angular` (rad/s).
+    pub fn lumber_calm(&self, linear: f64, angular: f64) -> bool {
+        self.lumber.values().all(|b| {
+            let body = &self.world.bodies[b.body];
+            !body.is_dynamic()
+                || (f64::from(body.linvel().length()) < linear
+                    && f64::from(body.angvel().length()) < angular)
+        })
     }
 
     /// The robot's colliders (base link excluded: it never moves) and the held piece's, with
@@ -1052,10 +768,7 @@ impl Physics {
     pub fn lumber_poses(&self) -> BTreeMap<String, Isometry3<f64>> {
         self.lumber
             .iter()
-            .map(|(id, b)| {
-                let pose = to_iso(self.world.bodies[b.body].position());
-                (id.clone(), self.ridden(id, pose))
-            })
+            .map(|(id, b)| (id.clone(), to_iso(self.world.bodies[b.body].position())))
             .collect()
     }
 }

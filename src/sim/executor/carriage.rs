@@ -117,14 +117,11 @@ impl<'a> WallRun<'a> {
             let base = track.base_at(from + profile.covered(distance, t));
             self.cell.robot_base = base;
             self.phys.set_robot_base(base);
-            self.base_moved();
             self.tick();
         }
         let base = track.base_at(to);
         self.cell.robot_base = base;
         self.phys.set_robot_base(base);
-        self.base_moved();
-        self.sync_world();
         Ok(())
     }
 

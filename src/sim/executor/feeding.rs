@@ -66,38 +66,6 @@ impl<'a> WallRun<'a> {
         self.on_belts.insert(next.id.clone());
     }
 
-    /// During a ride: how long until the feeder's next piece fits onto conveyor 1 (s), from the
-    /// riders' speeds; infinite when nothing carries the pieces in its way off.
-    pub(super) fn time_to_clear(&self) -> f64 {
-        let Some(next) = self.queue.front() else {
-            return f64::INFINITY;
-        };
-        let direction = self.cell.conveyor1.direction();
-        let local = next.spawn.rotation.inverse() * direction;
-        let length: f64 = (0..3).map(|i| local[i].abs() * next.size[i]).sum();
-        let mut wait: f64 = 0.0;
-        for id in &self.on_belts {
-            let Some(pose) = self.phys.lumber_pose(id) else {
-                continue;
-            };
-            let centre = self.belt1_position(&pose.translation.vector);
-            let half = piece_half_along(&pose, &direction, id, &self.pieces);
-            let deficit = length + self.cell.lumber_gap - (centre - half);
-            if deficit <= 0.0 {
-                continue;
-            }
-            let speed = self
-                .phys
-                .rider_velocity(id)
-                .map_or(0.0, |v| v.dot(&direction));
-            if speed <= 0.0 {
-                return f64::INFINITY;
-            }
-            wait = wait.max(deficit / speed);
-        }
-        wait
-    }
-
     /// Side by side: the piece at conveyor 1's stop rail is lifted onto conveyor 2's centre
     /// line, long axis along the belt, once no other piece is on conveyor 2 (a transfer arm
     /// between the two belts; it does not change where the piece lies along conveyor 2).
@@ -186,12 +154,6 @@ impl<'a> WallRun<'a> {
 
     /// Waits until `piece` touches the sensor. Err: why it did not arrive.
     pub(super) fn await_piece(&mut self, piece: &ScenePiece) -> Result<(), String> {
-        let result = self.wait_for_piece(piece);
-        self.sync_world();
-        result
-    }
-
-    fn wait_for_piece(&mut self, piece: &ScenePiece) -> Result<(), String> {
         let c1 = &self.cell.conveyor1;
         if c1.speed <= 0.0 || self.cell.conveyor2.speed <= 0.0 {
             return Err("a conveyor does not run (speed 0)".into());

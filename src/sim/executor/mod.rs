@@ -70,8 +70,6 @@ pub struct WallRun<'a> {
     progress: &'a (dyn Fn(usize, usize) + Sync),
     /// Event-driven stepping's state (unused with fixed steps).
     events: stepping::Events,
-    /// The bound on the wall's simulated time (s).
-    time_limit: f64,
 }
 
 impl<'a> WallRun<'a> {
@@ -115,20 +113,11 @@ impl<'a> WallRun<'a> {
             },
             progress,
             events: stepping::Events::new(&q),
-            time_limit: f64::INFINITY,
         }
     }
 
-    /// Bounds the wall's simulated time: `run` stops with the time reached once it is past
-    /// `seconds` (checked between pieces and before nailing).
-    pub fn with_time_limit(mut self, seconds: f64) -> WallRun<'a> {
-        self.time_limit = seconds;
-        self
-    }
-
-    /// Runs the wall: framing of every element, then nailing. Err: the simulated time
-    /// reached when the run went past its time limit.
-    pub fn run(mut self, nails: &[NailPlan]) -> Result<WallRecord, f64> {
+    /// Runs the wall: framing of every element, then nailing.
+    pub fn run(mut self, nails: &[NailPlan]) -> WallRecord {
         self.load_belts();
         self.phys.drive_robot(&self.q.clone());
         self.step();
@@ -141,14 +130,11 @@ impl<'a> WallRun<'a> {
         let total = self.pieces.len();
         for (done, piece) in self.pieces.clone().into_iter().enumerate() {
             (self.progress)(done, total);
-            self.check_time()?;
             self.frame(piece);
         }
         self.record.framing_end = self.t;
-        self.check_time()?;
         self.nail_all(nails);
         self.record.nailing_end = self.t;
-        self.check_time()?;
         self.settle();
         self.measure(nails);
         self.record.trace.finish();
@@ -164,14 +150,7 @@ impl<'a> WallRun<'a> {
                 depth,
             })
             .collect();
-        Ok(self.record)
-    }
-
-    fn check_time(&self) -> Result<(), f64> {
-        if self.t > self.time_limit {
-            return Err(self.t);
-        }
-        Ok(())
+        self.record
     }
 }
 
@@ -217,7 +196,6 @@ impl<'a> WallRun<'a> {
         for _ in 0..steps {
             self.tick();
         }
-        self.sync_world();
     }
 
     fn run_joint(&mut self, mv: &JointMove) {
@@ -227,17 +205,10 @@ impl<'a> WallRun<'a> {
             self.tick();
         }
         self.q = mv.to.clone();
-        self.sync_world();
     }
 
     /// Follows a straight TCP line; stops (returning the failure) if IK fails on the way.
     fn run_line(&mut self, mv: &LinearMove, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
-        let result = self.follow_line(mv, tcp);
-        self.sync_world();
-        result
-    }
-
-    fn follow_line(&mut self, mv: &LinearMove, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
         for k in 1..=steps {
             let pose = mv.pose_at(k as f64 * self.options.dt);
