@@ -294,7 +294,7 @@ fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
         "{reason}"
     );
     assert!(
-        reason.ends_with("[by framing_place_beyond_reach (rules/verdicts.dl:33)]"),
+        reason.ends_with("[by framing_place_beyond_reach (rules/verdicts.dl:35)]"),
         "{reason}"
     );
     assert!(

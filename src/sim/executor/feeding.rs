@@ -14,6 +14,10 @@ impl<'a> WallRun<'a> {
     /// Puts every piece whose spawn pose lies on conveyor 1 there; the rest wait in the queue.
     pub(super) fn load_belts(&mut self) {
         for p in self.pieces.clone() {
+            // What the cell cannot carry or grip is never fed (`frame` says why).
+            if self.carry_check(p).is_err() || self.grip_check(p).is_err() {
+                continue;
+            }
             if p.beyond_belt.is_none() && self.queue.is_empty() {
                 self.phys.add_lumber(p, &p.spawn);
                 self.on_belts.insert(p.id.clone());

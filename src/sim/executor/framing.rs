@@ -2,7 +2,7 @@
 
 use super::paths::distance;
 use super::{Held, WallRun, failure_score, raise};
-use crate::cell::IkFailure;
+use crate::cell::{Arrangement, IkFailure};
 use crate::sim::motion::LinearMove;
 use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
 use crate::sim::record::IkRecord;
@@ -47,6 +47,17 @@ struct FramingPlan {
 
 impl<'a> WallRun<'a> {
     pub(super) fn frame(&mut self, piece: &'a ScenePiece) {
+        // Lumber the cell cannot handle never goes on the belts (`load_belts` leaves it
+        // out): its verdict names why, not what the belts would have done to it (a 60 mm
+        // block on edge topples at the end stop; a 58 m plate falls off the belts' ends).
+        if let Err(why) = self.carry_check(piece) {
+            self.record.not_fed.push((piece.id.clone(), why));
+            return;
+        }
+        if let Err(why) = self.grip_check(piece) {
+            self.record.grip_failed.push((piece.id.clone(), why));
+            return;
+        }
         let start = self.begin(&piece.id, "feed", &[]);
         let fed = self.await_piece(piece);
         self.end(&piece.id, "feed", start);
@@ -76,11 +87,6 @@ impl<'a> WallRun<'a> {
                 piece.id.clone(),
                 "it toppled over at the end stop of conveyor 2 (it lies on its wide face); the gripper takes lumber standing on edge".into(),
             ));
-            self.take_off(&piece.id);
-            return;
-        }
-        if let Err(why) = self.grip_check(piece) {
-            self.record.grip_failed.push((piece.id.clone(), why));
             self.take_off(&piece.id);
             return;
         }
@@ -292,8 +298,30 @@ impl<'a> WallRun<'a> {
         });
     }
 
+    /// Whether the conveyors can carry the piece: no longer than conveyor 2, nor than
+    /// conveyor 1's deck is wide (side by side) or its belt long (end to end).
+    pub(super) fn carry_check(&self, piece: &ScenePiece) -> Result<(), String> {
+        let length = piece.size[0];
+        let c2 = self.cell.conveyor2.length;
+        let (c1, extent) = match self.cell.arrangement {
+            Arrangement::SideBySide => (self.cell.conveyor1.width, "wide"),
+            Arrangement::EndToEnd => (self.cell.conveyor1.length, "long"),
+        };
+        if length > c2 + 1e-9 {
+            return Err(format!(
+                "the conveyors cannot carry it: it is {length:.2} m long, conveyor 2 is {c2:.2} m long"
+            ));
+        }
+        if length > c1 + 1e-9 {
+            return Err(format!(
+                "the conveyors cannot carry it: it is {length:.2} m long, conveyor 1 is {c1:.2} m {extent}"
+            ));
+        }
+        Ok(())
+    }
+
     /// Whether the gripper can take the piece: jaws across its thickness, both grippers on it.
-    fn grip_check(&self, piece: &ScenePiece) -> Result<(), String> {
+    pub(super) fn grip_check(&self, piece: &ScenePiece) -> Result<(), String> {
         let Some(g) = &self.cell.tool.gripper else {
             return Err(format!("the tool {} has no gripper", self.cell.tool.name));
         };

@@ -285,11 +285,17 @@ fn joint_gap(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// A seed for the planner from the move's two ends (their exact bits).
+/// Joint values are rounded to this before they seed the planner (rad or m): ends that differ
+/// by the physics' micrometre noise (a piece's rest pose one way or another) get the same
+/// search.
+const SEED_QUANTUM: f64 = 1e-4;
+
+/// A seed for the planner from the move's two ends (rounded to SEED_QUANTUM).
 fn move_seed(from: &[f64], to: &[f64]) -> u64 {
     let mut hasher = blake3::Hasher::new();
     for v in from.iter().chain(to) {
-        hasher.update(&v.to_bits().to_le_bytes());
+        let q = (v / SEED_QUANTUM).round() as i64;
+        hasher.update(&q.to_le_bytes());
     }
     let bytes = hasher.finalize();
     u64::from_le_bytes(bytes.as_bytes()[..8].try_into().expect("32-byte hash"))
