@@ -11,12 +11,12 @@ use super::simulate::SimReport;
 use super::verdict;
 use crate::cell::{Cell, PlacedShape, Shape};
 use crate::sim::Simulation;
-use crate::sim::record::{LumberTrack, PoseTrace};
+use crate::sim::record::{LumberTrack, PoseTrace, WallRecord};
 use crate::world::Scene;
 use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
-use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3, Vector4};
 use std::collections::BTreeMap;
 
 /// Belt slab thickness drawn under a conveyor's top (m), as in the physics world.
@@ -47,8 +47,19 @@ pub fn wall_glb(
     report: &SimReport,
     wall_key: &str,
 ) -> Option<Vec<u8>> {
-    let record = sim.records.iter().find(|r| r.wall == wall_key)?;
-    let wall = sim.scene.walls.iter().find(|w| w.id == wall_key)?;
+    scene_wall_glb(cell, &sim.scene, &sim.records, report, wall_key)
+}
+
+/// `wall_glb` from the parts of a simulation it reads (they can be shared between threads).
+pub fn scene_wall_glb(
+    cell: &Cell,
+    scene: &Scene,
+    records: &[WallRecord],
+    report: &SimReport,
+    wall_key: &str,
+) -> Option<Vec<u8>> {
+    let record = records.iter().find(|r| r.wall == wall_key)?;
+    let wall = scene.walls.iter().find(|w| w.id == wall_key)?;
     let end = record.nailing_end;
     let trace = &record.trace;
     let mut g = Builder::new();
@@ -87,7 +98,7 @@ pub fn wall_glb(
     let rows: BTreeMap<&str, &super::simulate::ElementRow> =
         report.elements.iter().map(|e| (e.id.as_str(), e)).collect();
     for id in &wall.pieces {
-        let Some(piece) = sim.scene.pieces.iter().find(|p| &p.id == id) else {
+        let Some(piece) = scene.pieces.iter().find(|p| &p.id == id) else {
             continue;
         };
         let (class, role) = rows
@@ -138,16 +149,19 @@ pub fn reduce_keys(times: &[f64], poses: &[Isometry3<f64>]) -> Vec<usize> {
     if n <= 2 {
         return (0..n).collect();
     }
+    // Two unit quaternions lie within the angle tolerance of each other exactly when the
+    // absolute value of their dot product is at least its half angle's cosine.
+    let min_dot = (KEY_TOLERANCE.1 / 2.0).cos();
     let fits = |a: usize, b: usize| {
+        let slerp = Slerp::new(&poses[a].rotation, &poses[b].rotation);
         (a + 1..b).all(|k| {
             let s = (times[k] - times[a]) / (times[b] - times[a]);
             let pos = poses[a]
                 .translation
                 .vector
                 .lerp(&poses[b].translation.vector, s);
-            let rot = poses[a].rotation.slerp(&poses[b].rotation, s);
             (pos - poses[k].translation.vector).norm() <= KEY_TOLERANCE.0
-                && rot.angle_to(&poses[k].rotation) <= KEY_TOLERANCE.1
+                && slerp.at(s).dot(&poses[k].rotation.coords).abs() >= min_dot
         })
     };
     let mut kept = vec![0];
@@ -162,6 +176,42 @@ pub fn reduce_keys(times: &[f64], poses: &[Isometry3<f64>]) -> Vec<usize> {
     }
     kept.push(n - 1);
     kept
+}
+
+/// Spherical interpolation between two rotations (the short way, as glTF viewers and
+/// nalgebra's `slerp` interpolate), its angle worked out once for many fractions.
+struct Slerp {
+    a: Vector4<f64>,
+    b: Vector4<f64>,
+    angle: f64,
+    sin_angle: f64,
+}
+
+impl Slerp {
+    fn new(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> Slerp {
+        let a = a.coords;
+        let b = if a.dot(&b.coords) < 0.0 {
+            -b.coords
+        } else {
+            b.coords
+        };
+        let cos = a.dot(&b).min(1.0);
+        Slerp {
+            a,
+            b,
+            angle: cos.acos(),
+            sin_angle: (1.0 - cos * cos).sqrt(),
+        }
+    }
+
+    /// The interpolated rotation's coordinates at fraction `t`.
+    fn at(&self, t: f64) -> Vector4<f64> {
+        if self.sin_angle <= f64::EPSILON {
+            return self.a;
+        }
+        self.a * (((1.0 - t) * self.angle).sin() / self.sin_angle)
+            + self.b * ((t * self.angle).sin() / self.sin_angle)
+    }
 }
 
 #[derive(Default)]

@@ -17,6 +17,7 @@ use crate::cell::Cell;
 use crate::ifc::Model;
 use crate::sim::Simulation;
 use maud::{DOCTYPE, Markup, PreEscaped, html};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Walls drawn on the index page itself; more get a page each.
@@ -135,8 +136,20 @@ pub fn report_files_within(
             files.push((page_name(i), bytes));
         }
     }
-    for (i, w) in walls.iter().enumerate() {
-        if let Some(bytes) = glb::wall_glb(input.cell, input.sim, input.report, &w.record.wall) {
+    // The walls' scenes are independent: built in parallel, checked and kept in wall order.
+    let (cell, scene, records, report) = (
+        input.cell,
+        &input.sim.scene,
+        input.sim.records.as_slice(),
+        input.report,
+    );
+    let wall_ids: Vec<&str> = walls.iter().map(|w| w.record.wall.as_str()).collect();
+    let scenes: Vec<Option<Vec<u8>>> = wall_ids
+        .par_iter()
+        .map(|wall| glb::scene_wall_glb(cell, scene, records, report, wall))
+        .collect();
+    for (i, bytes) in scenes.into_iter().enumerate() {
+        if let Some(bytes) = bytes {
             check(&scene_name(i), &bytes)?;
             files.push((scene_name(i), bytes));
         }
