@@ -6,6 +6,7 @@ use crate::cell::Arrangement;
 use crate::sim::record::BeltEvent;
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use std::collections::HashMap;
 
 /// A piece this close to conveyor 1's stop rail is at the rail (m).
 const TRANSFER_REACH: f64 = 0.005;
@@ -52,7 +53,7 @@ impl<'a> WallRun<'a> {
                 return true;
             };
             let centre = self.belt1_position(&pose.translation.vector);
-            let half = piece_half_along(&pose, &self.cell.conveyor1.direction(), id, &self.pieces);
+            let half = piece_half_along(&pose, &self.cell.conveyor1.direction(), id, &self.sizes);
             centre - half >= length + self.cell.lumber_gap
         });
         if !clear {
@@ -94,7 +95,7 @@ impl<'a> WallRun<'a> {
                 }
                 continue;
             }
-            let half = piece_half_along(&pose, &c1.direction(), id, &self.pieces);
+            let half = piece_half_along(&pose, &c1.direction(), id, &self.sizes);
             let front = self.belt1_position(&pose.translation.vector) + half;
             if at_rail.is_none() && front >= c1.length - TRANSFER_REACH {
                 at_rail = Some((id.clone(), pose));
@@ -217,11 +218,11 @@ fn piece_half_along(
     pose: &Isometry3<f64>,
     direction: &Vector3<f64>,
     id: &str,
-    pieces: &[&ScenePiece],
+    sizes: &HashMap<String, [f64; 3]>,
 ) -> f64 {
-    let Some(p) = pieces.iter().find(|p| p.id == id) else {
+    let Some(size) = sizes.get(id) else {
         return 0.0;
     };
     let local = pose.rotation.inverse() * direction;
-    (0..3).map(|i| local[i].abs() * p.size[i] / 2.0).sum()
+    (0..3).map(|i| local[i].abs() * size[i] / 2.0).sum()
 }

@@ -27,7 +27,7 @@ use super::record::{ContactRecord, Operation, WallRecord};
 use crate::cell::{Cell, IkFailure};
 use crate::world::{ScenePiece, SceneWall};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
-use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use std::collections::{BTreeMap, BTreeSet, HashMap, VecDeque};
 
 /// A contact shallower than this is a touch, not a collision (m).
 const CONTACT_TOLERANCE: f64 = 0.001;
@@ -51,6 +51,8 @@ pub struct WallRun<'a> {
     phys: Physics,
     wall_cell: Isometry3<f64>,
     pieces: Vec<&'a ScenePiece>,
+    /// Each piece's size by id (the feeder looks them up every step).
+    sizes: HashMap<String, [f64; 3]>,
     t: f64,
     q: Vec<f64>,
     held: Option<Held>,
@@ -96,6 +98,7 @@ impl<'a> WallRun<'a> {
             options,
             phys,
             wall_cell: cell.robot_base * wall.wall_to_robot,
+            sizes: pieces.iter().map(|p| (p.id.clone(), p.size)).collect(),
             pieces,
             t: 0.0,
             q: q.clone(),
