@@ -9,7 +9,7 @@ use crate::cell::{Arrangement, Cell, PlacedShape, Shape};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// rapier pose of an f64 isometry.
 pub fn to_pose(iso: &Isometry3<f64>) -> Pose {
@@ -118,6 +118,8 @@ pub struct Physics {
     /// gripped, released, clamped, nailed; jaws; belts): a clearance measured at one count
     /// holds only at that count.
     generation: u64,
+    /// Pieces riding a running belt as kinematic bodies (see `start_ride`).
+    riding: BTreeSet<String>,
 }
 
 /// How far the robot, its tool and a held piece are from the rest of the world (m), each
@@ -372,6 +374,7 @@ impl Physics {
             lumber_of: HashMap::new(),
             cell: cell.clone(),
             generation: 0,
+            riding: BTreeSet::new(),
         }
     }
 
@@ -402,8 +405,53 @@ impl Physics {
             .insert(piece.id.clone(), LumberBody { body, collider });
     }
 
+    /// Lets a piece ride its running belt as a kinematic body at `velocity` (m/s): a piece
+    /// that only rides has nothing for the solver to do, and without contacts to the belt it
+    /// costs none. The feeder ends the ride (`end_ride`) before the piece nears anything;
+    /// stopping the belts ends every ride.
+    pub fn start_ride(&mut self, id: &str, velocity: &Vector3<f64>) {
+        let Some(b) = self.lumber.get(id).copied() else {
+            return;
+        };
+        if !self.riding.insert(id.to_string()) {
+            return;
+        }
+        self.generation += 1;
+        let body = &mut self.world.bodies[b.body];
+        body.set_body_type(RigidBodyType::KinematicVelocityBased, true);
+        body.set_angvel(Vector::ZERO, true);
+        body.set_linvel(
+            Vector::new(velocity.x as f32, velocity.y as f32, velocity.z as f32),
+            true,
+        );
+        if let Some(c) = self.world.colliders.get_mut(b.collider) {
+            c.set_active_collision_types(ActiveCollisionTypes::default());
+        }
+    }
+
+    /// A riding piece is a dynamic body again, moving as it rode.
+    pub fn end_ride(&mut self, id: &str) {
+        if !self.riding.remove(id) {
+            return;
+        }
+        let Some(b) = self.lumber.get(id).copied() else {
+            return;
+        };
+        self.generation += 1;
+        let body = &mut self.world.bodies[b.body];
+        let velocity = body.linvel();
+        body.set_body_type(RigidBodyType::Dynamic, true);
+        body.set_linvel(velocity, true);
+        if let Some(c) = self.world.colliders.get_mut(b.collider) {
+            c.set_active_collision_types(
+                ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED,
+            );
+        }
+    }
+
     /// Takes a piece out of the world (an operator lifts it off the belt).
     pub fn remove_lumber(&mut self, id: &str) {
+        self.riding.remove(id);
         self.generation += 1;
         if let Some(b) = self.lumber.remove(id) {
             self.world.remove_body_with_colliders(b.body, true);
@@ -544,6 +592,15 @@ impl Physics {
     /// Starts or stops both belts; a started belt wakes the lumber on it.
     pub fn set_belts(&mut self, running: bool) {
         self.generation += 1;
+        if !running {
+            let riding: Vec<String> = self.riding.iter().cloned().collect();
+            for id in riding {
+                self.end_ride(&id);
+                if let Some(b) = self.lumber.get(&id) {
+                    self.world.bodies[b.body].set_linvel(Vector::ZERO, true);
+                }
+            }
+        }
         if running && !self.belts.running {
             let bodies: Vec<RigidBodyHandle> = self.lumber.values().map(|b| b.body).collect();
             for b in bodies {

@@ -10,6 +10,9 @@ use std::collections::HashMap;
 
 /// A piece this close to conveyor 1's stop rail is at the rail (m).
 const TRANSFER_REACH: f64 = 0.005;
+/// A piece on conveyor 1 rides it without the solver while nothing lies within this ahead of
+/// it (m): 1 s of travel at the study's 0.05 m/s, time for it to settle against what it meets.
+const RIDE_CLEARANCE: f64 = 0.05;
 
 impl<'a> WallRun<'a> {
     /// Puts every piece whose spawn pose lies on conveyor 1 there; the rest wait in the queue.
@@ -37,6 +40,7 @@ impl<'a> WallRun<'a> {
     /// The feeder: the next queued piece goes onto conveyor 1's upstream end once the belt
     /// there is clear by the lumber gap.
     pub(super) fn feed(&mut self) {
+        self.update_rides();
         if self.cell.arrangement == Arrangement::SideBySide {
             self.transfer();
         }
@@ -69,6 +73,53 @@ impl<'a> WallRun<'a> {
         self.queue.pop_front();
         self.phys.add_lumber(next, &pose);
         self.on_belts.insert(next.id.clone());
+    }
+
+    /// Pieces on conveyor 1 with nothing within RIDE_CLEARANCE ahead of them (the next piece
+    /// or the belt's downstream end) ride it without the solver; the others are dynamic.
+    fn update_rides(&mut self) {
+        if !self.phys.belts.running {
+            return; // stopping the belts ended every ride
+        }
+        let c1 = self.cell.conveyor1;
+        let c2 = &self.cell.conveyor2;
+        let direction = c1.direction();
+        // (back, front, id) along conveyor 1 of every piece whose centre lies on it.
+        let mut on_c1: Vec<(f64, f64, &String)> = Vec::new();
+        for id in &self.on_belts {
+            if self.transferred.contains(id) {
+                continue;
+            }
+            let Some(pose) = self.phys.lumber_pose(id) else {
+                continue;
+            };
+            let centre = self.belt1_position(&pose.translation.vector);
+            let local = c2.pose.inverse() * Point3::from(pose.translation.vector);
+            let on_c2 = local.x.abs() <= c2.length / 2.0 && local.y.abs() <= c2.width / 2.0;
+            if on_c2 || !(0.0..=c1.length).contains(&centre) {
+                continue;
+            }
+            let half = piece_half_along(&pose, &direction, id, &self.sizes);
+            on_c1.push((centre - half, centre + half, id));
+        }
+        on_c1.sort_by(|a, b| a.1.total_cmp(&b.1).then_with(|| a.2.cmp(b.2)));
+        let mut start = Vec::new();
+        let mut end = Vec::new();
+        for (i, (_, front, id)) in on_c1.iter().enumerate() {
+            let ahead = on_c1.get(i + 1).map_or(c1.length, |next| next.0);
+            if ahead - front > RIDE_CLEARANCE {
+                start.push((*id).clone());
+            } else {
+                end.push((*id).clone());
+            }
+        }
+        let velocity = direction * c1.speed;
+        for id in start {
+            self.phys.start_ride(&id, &velocity);
+        }
+        for id in end {
+            self.phys.end_ride(&id);
+        }
     }
 
     /// Side by side: the piece at conveyor 1's stop rail is lifted onto conveyor 2's centre
