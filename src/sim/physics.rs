@@ -870,3 +870,69 @@ pub fn collider(shape: &PlacedShape) -> ColliderBuilder {
     };
     builder.position(to_pose(&pose))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 0.5 m piece standing on conveyor 1's deck, its centre on the deck's centre.
+    fn piece_on_deck(cell: &Cell) -> (ScenePiece, Isometry3<f64>) {
+        let size = [0.5, 0.1, 0.1];
+        let pose = cell.conveyor1.pose * Isometry3::translation(0.0, 0.0, size[2] / 2.0);
+        let piece = ScenePiece {
+            id: "p".into(),
+            name: "p".into(),
+            ifc_type: "IfcMember".into(),
+            wall: "W1".into(),
+            slot: 0,
+            size,
+            material: "wood".into(),
+            density: 450.0,
+            mass: 450.0 * size.iter().product::<f64>(),
+            spawn: pose,
+            beyond_belt: None,
+            target_robot: pose,
+            target_cell: pose,
+            on_edge: true,
+        };
+        (piece, pose)
+    }
+
+    #[test]
+    fn a_riding_piece_moves_at_the_belt_speed_and_is_dynamic_again_when_the_belts_stop() {
+        let cell = Cell::load("study-abb").expect("cell");
+        let dt = 1.0 / 240.0;
+        let mut phys = Physics::new(&cell, &cell.robot.home(), dt);
+        let (piece, pose) = piece_on_deck(&cell);
+        phys.add_lumber(&piece, &pose);
+        phys.set_belts(true);
+        for _ in 0..240 {
+            phys.step();
+        }
+        let before = phys.lumber_pose("p").expect("piece");
+        let velocity = cell.conveyor1.direction() * cell.conveyor1.speed;
+        phys.start_ride("p", &velocity);
+        let steps = 480;
+        for _ in 0..steps {
+            phys.step();
+        }
+        let after = phys.lumber_pose("p").expect("piece");
+        let expected = velocity * (steps as f64 * dt);
+        let moved = after.translation.vector - before.translation.vector;
+        // The world is f32: each step rounds the position by up to about one unit in the last
+        // place at the piece's distance from the origin.
+        let rounding =
+            steps as f64 * 2.0 * f64::from(f32::EPSILON) * after.translation.vector.amax();
+        assert!(
+            (moved - expected).norm() < rounding,
+            "moved {moved:?}, the belt {expected:?}"
+        );
+        assert!(after.rotation.angle_to(&before.rotation) < 1e-6);
+        let body = phys.lumber["p"].body;
+        assert!(phys.world.bodies[body].is_kinematic());
+        // Stopping the belts ends the ride: a dynamic body at rest.
+        phys.set_belts(false);
+        assert!(phys.world.bodies[body].is_dynamic());
+        assert!(phys.lumber_speed("p").expect("piece").0 < 1e-9);
+    }
+}
