@@ -82,6 +82,13 @@ impl<'a> WallRun<'a> {
             return; // stopping the belts ended every ride
         }
         let c1 = self.cell.conveyor1;
+        // Looked at every so many ticks: between two looks a piece travels at most a fifth of
+        // the clearance, so a ride always ends with most of it still ahead.
+        let travel = c1.speed * self.options.dt;
+        let every = ((RIDE_CLEARANCE / 5.0) / travel).floor().max(1.0) as u64;
+        if ((self.t / self.options.dt).round() as u64) % every != 0 {
+            return;
+        }
         let c2 = &self.cell.conveyor2;
         let direction = c1.direction();
         // (back, front, id) along conveyor 1 of every piece whose centre lies on it.
