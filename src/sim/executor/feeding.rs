@@ -86,7 +86,7 @@ impl<'a> WallRun<'a> {
         // the clearance, so a ride always ends with most of it still ahead.
         let travel = c1.speed * self.options.dt;
         let every = ((RIDE_CLEARANCE / 5.0) / travel).floor().max(1.0) as u64;
-        if ((self.t / self.options.dt).round() as u64) % every != 0 {
+        if !((self.t / self.options.dt).round() as u64).is_multiple_of(every) {
             return;
         }
         let c2 = &self.cell.conveyor2;
