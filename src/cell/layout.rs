@@ -317,6 +317,11 @@ impl Conveyor {
     pub fn upstream_end(&self) -> Point3<f64> {
         self.pose * Point3::new(-self.length / 2.0, 0.0, 0.0)
     }
+    /// Whether a point lies over the belt's top surface (seen from above).
+    pub fn covers(&self, point: &Point3<f64>) -> bool {
+        let local = self.pose.inverse() * point;
+        local.x.abs() <= self.length / 2.0 && local.y.abs() <= self.width / 2.0
+    }
 }
 
 /// The touch sensor box at the downstream end of conveyor 2 (`pose`: its centre, x along the

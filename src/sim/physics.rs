@@ -11,6 +11,12 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
+/// Which pairs lumber collides in: the defaults, and a held (kinematic) piece with fixed
+/// bodies too. A piece riding a belt (`start_ride`) drops the latter.
+fn lumber_collision_types() -> ActiveCollisionTypes {
+    ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED
+}
+
 /// rapier pose of an f64 isometry.
 pub fn to_pose(iso: &Isometry3<f64>) -> Pose {
     iso.cast::<f32>().into()
@@ -394,9 +400,7 @@ impl Physics {
                 .density(piece.density as f32)
                 .friction(LUMBER_FRICTION)
                 .collision_groups(groups(LUMBER, FIXED | LUMBER | ROBOT | SENSOR))
-                .active_collision_types(
-                    ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED,
-                ),
+                .active_collision_types(lumber_collision_types()),
             Some(body),
         );
         self.names.insert(collider, format!("piece {}", piece.id));
@@ -443,9 +447,7 @@ impl Physics {
         body.set_body_type(RigidBodyType::Dynamic, true);
         body.set_linvel(velocity, true);
         if let Some(c) = self.world.colliders.get_mut(b.collider) {
-            c.set_active_collision_types(
-                ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED,
-            );
+            c.set_active_collision_types(lumber_collision_types());
         }
     }
 

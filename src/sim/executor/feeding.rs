@@ -89,7 +89,6 @@ impl<'a> WallRun<'a> {
         if !((self.t / self.options.dt).round() as u64).is_multiple_of(every) {
             return;
         }
-        let c2 = &self.cell.conveyor2;
         let direction = c1.direction();
         // (back, front, id) along conveyor 1 of every piece whose centre lies on it.
         let mut on_c1: Vec<(f64, f64, &String)> = Vec::new();
@@ -101,8 +100,10 @@ impl<'a> WallRun<'a> {
                 continue;
             };
             let centre = self.belt1_position(&pose.translation.vector);
-            let local = c2.pose.inverse() * Point3::from(pose.translation.vector);
-            let on_c2 = local.x.abs() <= c2.length / 2.0 && local.y.abs() <= c2.width / 2.0;
+            let on_c2 = self
+                .cell
+                .conveyor2
+                .covers(&Point3::from(pose.translation.vector));
             if on_c2 || !(0.0..=c1.length).contains(&centre) {
                 continue;
             }
@@ -138,10 +139,8 @@ impl<'a> WallRun<'a> {
         }
         let c1 = &self.cell.conveyor1;
         let c2 = &self.cell.conveyor2;
-        let on_conveyor2 = |pose: &Isometry3<f64>| {
-            let local = c2.pose.inverse() * Point3::from(pose.translation.vector);
-            local.x.abs() <= c2.length / 2.0 && local.y.abs() <= c2.width / 2.0
-        };
+        let on_conveyor2 =
+            |pose: &Isometry3<f64>| c2.covers(&Point3::from(pose.translation.vector));
         let mut at_rail = None;
         for id in &self.on_belts {
             let Some(pose) = self.phys.lumber_pose(id) else {
