@@ -83,6 +83,42 @@ pub enum SimError {
     NoWalls { reason: String },
     #[error("bad simulation option: {0}")]
     Option(String),
+    #[error(
+        "{variable}={value:?} is not a number of seconds above 0; set it to one (e.g. {variable}=36000) or unset it for the default {DEFAULT_MAX_SIM_SECONDS_PER_WALL} s"
+    )]
+    BadLimit {
+        variable: &'static str,
+        value: String,
+    },
+    #[error(
+        "{wall} did not finish within the bound of {limit} s of simulated time per wall (it had run {reached:.1} s); raise the bound with {ENV_MAX_SIM_SECONDS_PER_WALL}=SECONDS if the wall really takes longer"
+    )]
+    TimeLimit {
+        wall: String,
+        limit: f64,
+        reached: f64,
+    },
+}
+
+/// The environment variable that sets the bound on simulated time per wall (s).
+pub const ENV_MAX_SIM_SECONDS_PER_WALL: &str = "FRAMEWRIGHT_MAX_SIM_SECONDS_PER_WALL";
+/// The bound's default: 10 h of simulated time, some ten times the longest wall of the
+/// 3-storey test model.
+pub const DEFAULT_MAX_SIM_SECONDS_PER_WALL: f64 = 36_000.0;
+
+/// The bound on simulated time per wall (s): the environment's value, else the default; a
+/// value that is not a positive number is an error naming the variable.
+pub fn max_sim_seconds_per_wall() -> Result<f64, SimError> {
+    match std::env::var(ENV_MAX_SIM_SECONDS_PER_WALL) {
+        Err(_) => Ok(DEFAULT_MAX_SIM_SECONDS_PER_WALL),
+        Ok(value) => match value.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+            _ => Err(SimError::BadLimit {
+                variable: ENV_MAX_SIM_SECONDS_PER_WALL,
+                value,
+            }),
+        },
+    }
 }
 
 /// A finished simulation.
@@ -112,6 +148,7 @@ pub fn simulate_with_progress(
 ) -> Result<Simulation, SimError> {
     use rayon::prelude::*;
     check_options(options)?;
+    let limit = max_sim_seconds_per_wall()?;
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
     crate::frame::placement::add_placement_facts(&mut facts, cell, &options.engine)?;
@@ -122,7 +159,7 @@ pub fn simulate_with_progress(
 
     let records: Vec<WallRecord> = selected
         .par_iter()
-        .filter_map(|key| {
+        .filter_map(|key| -> Option<Result<WallRecord, SimError>> {
             // The rules name a wall by its key piece; the scene does too.
             let scene_wall = scene.walls.iter().find(|w| &w.id == key)?;
             let plan_wall = plan.walls.iter().find(|w| &w.key == key)?;
@@ -133,9 +170,16 @@ pub fn simulate_with_progress(
                 .collect();
             let nails = NailPlan::from_targets(&plan_wall.nailing_targets, &plan_wall.frame);
             let report = |done: usize, total: usize| progress(&plan_wall.name, done, total);
-            Some(executor::WallRun::new(cell, options, scene_wall, pieces, &report).run(&nails))
+            let run = executor::WallRun::new(cell, options, scene_wall, pieces, &report)
+                .with_time_limit(limit)
+                .run(&nails);
+            Some(run.map_err(|reached| SimError::TimeLimit {
+                wall: format!("{} ({})", plan_wall.name, plan_wall.id),
+                limit,
+                reached,
+            }))
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
 
     let mut sim_facts = Facts::default();
     for r in &records {

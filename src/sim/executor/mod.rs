@@ -72,6 +72,8 @@ pub struct WallRun<'a> {
     progress: &'a (dyn Fn(usize, usize) + Sync),
     /// Event-driven stepping's state (unused with fixed steps).
     events: stepping::Events,
+    /// The bound on the wall's simulated time (s).
+    time_limit: f64,
 }
 
 impl<'a> WallRun<'a> {
@@ -116,11 +118,20 @@ impl<'a> WallRun<'a> {
             },
             progress,
             events: stepping::Events::new(&q),
+            time_limit: f64::INFINITY,
         }
     }
 
-    /// Runs the wall: framing of every element, then nailing.
-    pub fn run(mut self, nails: &[NailPlan]) -> WallRecord {
+    /// Bounds the wall's simulated time: `run` stops with the time reached once it is past
+    /// `seconds` (checked between pieces, before and after nailing).
+    pub fn with_time_limit(mut self, seconds: f64) -> WallRun<'a> {
+        self.time_limit = seconds;
+        self
+    }
+
+    /// Runs the wall: framing of every element, then nailing. Err: the simulated time
+    /// reached when the run went past its time limit.
+    pub fn run(mut self, nails: &[NailPlan]) -> Result<WallRecord, f64> {
         self.load_belts();
         self.phys.drive_robot(&self.q.clone());
         self.step();
@@ -133,11 +144,14 @@ impl<'a> WallRun<'a> {
         let total = self.pieces.len();
         for (done, piece) in self.pieces.clone().into_iter().enumerate() {
             (self.progress)(done, total);
+            self.check_time()?;
             self.frame(piece);
         }
         self.record.framing_end = self.t;
+        self.check_time()?;
         self.nail_all(nails);
         self.record.nailing_end = self.t;
+        self.check_time()?;
         self.settle();
         self.measure(nails);
         self.record.trace.finish();
@@ -153,7 +167,14 @@ impl<'a> WallRun<'a> {
                 depth,
             })
             .collect();
-        self.record
+        Ok(self.record)
+    }
+
+    fn check_time(&self) -> Result<(), f64> {
+        if self.t > self.time_limit {
+            return Err(self.t);
+        }
+        Ok(())
     }
 }
 
