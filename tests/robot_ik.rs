@@ -324,3 +324,61 @@ fn near_singular_wrists_round_trip() {
         }
     }
 }
+
+/// `ik_closest` is `ik`'s first solution, computed without listing the others: the same
+/// joint values bit for bit, or the same failure, on reachable, unreachable and
+/// limit-bound poses from random seeds, with and without a TCP offset (both shipped robots
+/// and the numeric fallback of the 7-axis fixture).
+#[test]
+fn ik_closest_is_the_first_of_all_solutions() {
+    let arm7 = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/robots/arm7.urdf"
+    );
+    let offset = Isometry3::from_parts(
+        Translation3::new(0.05, -0.02, 0.31),
+        UnitQuaternion::from_euler_angles(0.1, -0.4, 0.7),
+    );
+    for (name, n) in [(ROBOTS[0], 4000), (ROBOTS[1], 4000), (arm7, 40)] {
+        let robot = Robot::load(name).unwrap();
+        // Joints drawn over up to two turns beyond the usual range, so several whole-turn
+        // copies of the wrist joints fit and the seed decides among them.
+        let limits: Vec<(f64, f64)> = robot
+            .limits()
+            .iter()
+            .map(|&(lo, hi)| (lo.max(-7.0), hi.min(7.0)))
+            .collect();
+        let mut rng = Lcg(77);
+        let (mut solved, mut failed) = (0, 0);
+        for k in 0..n {
+            let q = rng.joints(&limits);
+            let mut pose = robot.fk_tip(&q);
+            if k % 5 == 4 {
+                // Some poses pushed out of reach or towards the limits.
+                pose.translation.vector *= 1.0 + rng.next();
+            }
+            let seed = rng.joints(&limits);
+            for tcp in [Isometry3::identity(), offset] {
+                let target = pose * tcp;
+                match (
+                    robot.ik(&target, &tcp, &seed),
+                    robot.ik_closest(&target, &tcp, &seed),
+                ) {
+                    (Ok(all), Ok(first)) => {
+                        assert_eq!(all[0], first, "{name} #{k}");
+                        solved += 1;
+                    }
+                    (Err(a), Err(b)) => {
+                        assert_eq!(a.to_string(), b.to_string(), "{name} #{k}");
+                        failed += 1;
+                    }
+                    (a, b) => panic!("{name} #{k}: ik {a:?} but ik_closest {b:?}"),
+                }
+            }
+        }
+        assert!(
+            solved > n / 2 && failed > 0,
+            "{name}: {solved} solved, {failed} failed"
+        );
+    }
+}

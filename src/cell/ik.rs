@@ -148,7 +148,7 @@ impl Robot {
         let target = pose * tcp.inverse();
         match &self.opw {
             Some(_) => Ok(self
-                .ik_closed_form(&target, seed, options)?
+                .ik_closed_form(&target, seed, options, Variants::All)?
                 .into_iter()
                 .map(|q| q.to_vec())
                 .collect()),
@@ -197,13 +197,57 @@ impl Robot {
         }
         let target = pose * tcp.inverse();
         match &self.opw {
-            Some(_) => self.ik_closed_form(&target, seed, options),
+            Some(_) => self.ik_closed_form(&target, seed, options, Variants::All),
             None => Ok(self
                 .ik_numeric(&target, seed, options)?
                 .into_iter()
                 .map(|s| std::array::from_fn(|i| s[i]))
                 .collect()),
         }
+    }
+
+    /// The solution of `ik` closest to `seed` (its first), without listing the others: the
+    /// distance to the seed is a sum over joints, so each closed-form branch contributes only
+    /// its whole-turn copy nearest the seed. Same answer and same failures as `ik`.
+    pub fn ik_closest(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64],
+    ) -> Result<Vec<f64>, IkFailure> {
+        if self.opw.is_some() && self.dof() == 6 {
+            let seed6: [f64; 6] = std::array::from_fn(|i| seed[i]);
+            return self.ik6_closest(pose, tcp, &seed6).map(|q| q.to_vec());
+        }
+        let mut solutions = self.ik(pose, tcp, seed)?;
+        Ok(solutions.swap_remove(0))
+    }
+
+    /// `ik6`'s first solution, computed as `ik_closest` does.
+    pub fn ik6_closest(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64; 6],
+    ) -> Result<[f64; 6], IkFailure> {
+        assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
+        let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
+        if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
+            return Err(IkFailure::InvalidPose);
+        }
+        let target = pose * tcp.inverse();
+        let mut solutions = match &self.opw {
+            Some(_) => {
+                self.ik_closed_form(&target, seed, &IkOptions::default(), Variants::Nearest)?
+            }
+            None => {
+                let q = self
+                    .ik_numeric(&target, seed, &IkOptions::default())?
+                    .swap_remove(0);
+                return Ok(std::array::from_fn(|i| q[i]));
+            }
+        };
+        Ok(solutions.swap_remove(0))
     }
 
     /// Distance (m) and rotation angle (rad) between the tip at `q` and `target`.
@@ -221,6 +265,7 @@ impl Robot {
         target: &Isometry3<f64>,
         seed: &[f64],
         options: &IkOptions,
+        variants: Variants,
     ) -> Result<Vec<[f64; 6]>, IkFailure> {
         let opw = self.opw.as_ref().expect("closed form");
         let raw = opw.solve(target, seed[3]);
@@ -263,7 +308,10 @@ impl Robot {
             let t5 = raw.wrist_angles[k];
             let wrist = t5.abs().min(PI - t5.abs());
             let before = within.len();
-            push_turn_variants(cand, &limits, wrist, &mut within);
+            match variants {
+                Variants::All => push_turn_variants(cand, &limits, wrist, &mut within),
+                Variants::Nearest => push_nearest_variant(cand, &limits, wrist, seed, &mut within),
+            }
             if within.len() == before {
                 beyond_limits[n_beyond] = k;
                 n_beyond += 1;
@@ -366,6 +414,50 @@ impl Robot {
             excess,
         }
     }
+}
+
+/// Which whole-turn copies of a closed-form branch to keep.
+#[derive(Clone, Copy)]
+enum Variants {
+    /// Every copy within the limits.
+    All,
+    /// Per joint, the copy nearest the seed (the first of equals, as `All` sorts them).
+    Nearest,
+}
+
+/// Push the copy of `q` shifted by whole turns that fits the limits and lies nearest `seed`,
+/// joint by joint: the one `push_turn_variants` would sort first.
+fn push_nearest_variant(
+    q: &[f64; 6],
+    limits: &[(f64, f64); 6],
+    wrist: f64,
+    seed: &[f64],
+    out: &mut Vec<([f64; 6], f64)>,
+) {
+    let mut best = [0.0f64; 6];
+    for i in 0..6 {
+        let (lo, hi) = limits[i];
+        if !(lo.is_finite() && hi.is_finite()) {
+            best[i] = q[i];
+            continue;
+        }
+        let mut x = q[i] + 2.0 * PI * ((lo - q[i]) / (2.0 * PI)).ceil();
+        let mut chosen: Option<f64> = None;
+        let mut count = 0;
+        while x <= hi + 1e-12 && count < 4 {
+            let v = x.clamp(lo, hi);
+            if chosen.is_none_or(|c| (v - seed[i]).powi(2) < (c - seed[i]).powi(2)) {
+                chosen = Some(v);
+            }
+            count += 1;
+            x += 2.0 * PI;
+        }
+        match chosen {
+            Some(v) => best[i] = v,
+            None => return,
+        }
+    }
+    out.push((best, wrist));
 }
 
 /// Push every copy of `q` shifted by whole turns that fits the limits (all joints revolute).

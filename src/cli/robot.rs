@@ -1,7 +1,7 @@
 //! `framewright robot fk|ik|cell`: forward and inverse kinematics of a robot (built-in name or
 //! URDF path) and a check of a cell file.
 
-use super::{CmdResult, Failure, print_stdout};
+use super::{CmdResult, Failure, print_stdout, write_stdout};
 use framewright::cell::{Cell, IkFailure, Robot, Tool, matrix_rows};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use serde_json::json;
@@ -51,6 +51,10 @@ pub enum RobotCommand {
         /// Print JSON (`{"solutions": …}` or `{"error": …}`) instead of text.
         #[arg(long)]
         json: bool,
+        /// Print only the closest solution of each pose (one answer per pose, as a numeric
+        /// solver gives; `Robot::ik_closest`, which does not list the others).
+        #[arg(long)]
+        closest: bool,
         /// Print solve-time statistics to stderr as JSON: the time of each library IK call
         /// (`Robot::ik6` for 6-axis arms), without parsing or output.
         #[arg(long)]
@@ -80,6 +84,7 @@ pub fn run(cmd: RobotCommand) -> CmdResult {
             tool_model,
             seed,
             json,
+            closest,
             stats,
         } => {
             let robot = Robot::load(&robot)?;
@@ -101,7 +106,12 @@ pub fn run(cmd: RobotCommand) -> CmdResult {
                 Some(s) => parse_joints(&robot, &s, "--seed")?,
                 None => robot.home(),
             };
-            let solver = Solver { robot, tcp, seed };
+            let solver = Solver {
+                robot,
+                tcp,
+                seed,
+                closest,
+            };
             match (pose, poses) {
                 (Some(p), _) => solver.single(&p, json),
                 (None, Some(file)) => solver.batch(&file, json, stats),
@@ -188,6 +198,8 @@ struct Solver {
     robot: Robot,
     tcp: Isometry3<f64>,
     seed: Vec<f64>,
+    /// Keep only the first (closest) solution.
+    closest: bool,
 }
 
 /// Solutions of one pose: fixed-size for 6-axis arms (the fast path), any length otherwise.
@@ -205,25 +217,49 @@ impl Answer {
     }
 }
 
+/// The JSON line of a solved pose, serialised straight from the solutions (no `Value` tree:
+/// a batch of 10,000 poses prints over a million numbers).
+#[derive(serde::Serialize)]
+struct SolutionsLine<'a> {
+    solutions: Vec<&'a [f64]>,
+}
+
 impl Solver {
     fn solve(&self, pose: &Isometry3<f64>) -> Result<Answer, IkFailure> {
-        if self.robot.dof() == 6 {
-            let seed: [f64; 6] = std::array::from_fn(|i| self.seed[i]);
-            self.robot.ik6(pose, &self.tcp, &seed).map(Answer::Six)
-        } else {
-            self.robot.ik(pose, &self.tcp, &self.seed).map(Answer::Any)
+        match (self.robot.dof() == 6, self.closest) {
+            (true, false) => {
+                let seed: [f64; 6] = std::array::from_fn(|i| self.seed[i]);
+                self.robot.ik6(pose, &self.tcp, &seed).map(Answer::Six)
+            }
+            (true, true) => {
+                let seed: [f64; 6] = std::array::from_fn(|i| self.seed[i]);
+                (self.robot.ik6_closest(pose, &self.tcp, &seed)).map(|q| Answer::Six(vec![q]))
+            }
+            (false, false) => self.robot.ik(pose, &self.tcp, &self.seed).map(Answer::Any),
+            (false, true) => {
+                (self.robot.ik_closest(pose, &self.tcp, &self.seed)).map(|q| Answer::Any(vec![q]))
+            }
         }
     }
 
-    fn answer_json(result: &Result<Answer, IkFailure>) -> String {
-        match result {
-            Ok(sols) => json!({ "solutions": sols.rows() }).to_string(),
-            // Serialised directly so that `kind` comes first, then the numbers.
-            Err(fail) => format!(
-                "{{\"error\":{}}}",
-                serde_json::to_string(fail).expect("IkFailure serialises")
+    /// Appends the pose's JSON answer (no newline) to `out`.
+    fn answer_json(out: &mut Vec<u8>, result: &Result<Answer, IkFailure>) {
+        let written = match result {
+            Ok(sols) => serde_json::to_writer(
+                &mut *out,
+                &SolutionsLine {
+                    solutions: sols.rows(),
+                },
             ),
-        }
+            // Serialised directly so that `kind` comes first, then the numbers.
+            Err(fail) => {
+                out.extend_from_slice(b"{\"error\":");
+                let written = serde_json::to_writer(&mut *out, fail);
+                out.push(b'}');
+                written
+            }
+        };
+        written.expect("IK answers serialise (finite numbers only)");
     }
 
     fn answer_text(result: &Result<Answer, IkFailure>) -> String {
@@ -246,12 +282,14 @@ impl Solver {
             .map_err(|e| Failure::bad_input(format!("--pose: {e}")))?;
         let pose = parse_pose(&values).map_err(|e| Failure::bad_input(format!("--pose: {e}")))?;
         let result = self.solve(&pose);
-        let text = if json {
-            format!("{}\n", Self::answer_json(&result))
+        if json {
+            let mut out = vec![];
+            Self::answer_json(&mut out, &result);
+            out.push(b'\n');
+            write_stdout(|w| w.write_all(&out))?;
         } else {
-            Self::answer_text(&result)
-        };
-        print_stdout(&text)?;
+            print_stdout(&Self::answer_text(&result))?;
+        }
         Ok(if result.is_ok() {
             ExitCode::SUCCESS
         } else {
@@ -285,13 +323,15 @@ impl Solver {
             times.push(start.elapsed().as_secs_f64());
             results.push(result);
         }
-        let mut out = String::new();
+        let mut out: Vec<u8> = vec![];
         for (i, r) in results.iter().enumerate() {
             if json {
-                out.push_str(&Self::answer_json(r));
-                out.push('\n');
+                Self::answer_json(&mut out, r);
+                out.push(b'\n');
             } else {
-                out.push_str(&format!("pose {}: {}", i + 1, Self::answer_text(r)));
+                out.extend_from_slice(
+                    format!("pose {}: {}", i + 1, Self::answer_text(r)).as_bytes(),
+                );
             }
         }
         if stats {
@@ -313,7 +353,7 @@ impl Solver {
             });
             let _ = writeln!(std::io::stderr(), "{line}");
         }
-        print_stdout(&out)
+        write_stdout(|w| w.write_all(&out))
     }
 }
 

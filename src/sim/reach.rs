@@ -18,9 +18,7 @@ pub fn solve(
     tcp: &Isometry3<f64>,
     seed: &[f64],
 ) -> Result<Vec<f64>, IkFailure> {
-    let pose = cell.to_robot(pose_cell);
-    let mut solutions = cell.robot.ik(&pose, tcp, seed)?;
-    Ok(solutions.swap_remove(0))
+    cell.robot.ik_closest(&cell.to_robot(pose_cell), tcp, seed)
 }
 
 /// How far inside the arm's reach a TCP pose lies (m): the closed-form wrist-centre margin,
