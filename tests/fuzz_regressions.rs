@@ -133,6 +133,41 @@ fn deeply_nested_rules_get_a_message_not_a_stack_overflow() {
     Program::parse_str("fine.dl", &fine).unwrap();
 }
 
+// Found by libFuzzer (rules_front, kept in tests/fixtures/fuzz/rules_front/): a `(` is read
+// first as a parenthesised body, then as an expression, and aggregates put bodies back inside
+// expressions, so each `(sum y : {` level doubled the work: 20 levels took 1.3 s and the
+// nesting bound's 33 would have taken days. Now every level is read once per depth.
+#[test]
+fn nested_aggregate_groups_are_read_in_linear_time() {
+    let head = ".decl a(x: number)\n.decl r(x: number)\na(x) :- r(x), ";
+    for levels in [20, 33, 99, 2_000] {
+        let text = format!(
+            "{head}{}x{}.\n",
+            "(sum y : {".repeat(levels),
+            "}".repeat(levels)
+        );
+        let (done, finished) = mpsc::channel();
+        std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn(move || {
+                let _ = done.send(
+                    Program::parse_str("agg.dl", &text)
+                        .err()
+                        .map(|e| e.to_string()),
+                );
+            })
+            .unwrap();
+        let message = finished
+            .recv_timeout(Duration::from_secs(10))
+            .unwrap_or_else(|_| panic!("{levels} nested aggregate groups still parsing after 10 s"))
+            .expect("an unclosed group is an error");
+        assert!(message.contains("agg.dl:3:"), "{message}");
+    }
+    // A valid nesting of groups and aggregates reads as before.
+    let ok = ".decl a(x: number)\n.decl r(x: number)\na(x) :- r(x), ((r(x), (x < 3 ; x > 5))), x = (sum y : { r(y), ((y > 1)) }).\n";
+    Program::parse_str("ok.dl", ok).unwrap();
+}
+
 // 200,000 nested elements took about a minute in the URDF parser (quadratic in depth).
 #[test]
 fn deeply_nested_urdf_is_refused_before_parsing() {

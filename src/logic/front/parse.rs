@@ -74,6 +74,9 @@ const BITWISE: [&str; 11] = [
 const MAX_NESTING: usize = 100;
 const MAX_OPERATORS: usize = 1000;
 
+/// A parenthesised disjunction read: the token position after it and its literals.
+type Group = (usize, Vec<Vec<Literal>>);
+
 pub struct Parser<'a> {
     toks: &'a [Token],
     pos: usize,
@@ -84,6 +87,11 @@ pub struct Parser<'a> {
     depth: usize,
     /// Operators read in the current item.
     operators: usize,
+    /// Outcome of reading a parenthesised disjunction at (token position, nesting depth):
+    /// where it ended and what it held, or None when it failed. A `(` is first tried as a
+    /// disjunction, then as an expression, which can hold aggregates whose bodies hold the
+    /// same `(` again: without this, nested groups would be read 2^depth times.
+    groups: std::collections::HashMap<(usize, usize), Option<Group>>,
 }
 
 impl<'a> Parser<'a> {
@@ -95,6 +103,7 @@ impl<'a> Parser<'a> {
             prev_end_line: 0,
             depth: 0,
             operators: 0,
+            groups: std::collections::HashMap::new(),
         }
     }
 
@@ -556,6 +565,21 @@ impl<'a> Parser<'a> {
         Ok(acc)
     }
 
+    /// The disjunction inside the `(` at token `at`: (the position after it, its literals),
+    /// or None when none reads there. Remembered (see `groups`): the outcome depends only on
+    /// the position and the depth (the nesting bound), and on the operator count, which only
+    /// grows, so a failure for too many operators would fail again.
+    fn group(&mut self, at: usize) -> Option<Group> {
+        let key = (at, self.depth);
+        if let Some(known) = self.groups.get(&key) {
+            return known.clone();
+        }
+        self.pos = at + 1;
+        let outcome = self.disjunction().ok().map(|d| (self.pos, d));
+        self.groups.insert(key, outcome.clone());
+        outcome
+    }
+
     fn term(&mut self) -> Result<Vec<Vec<Literal>>, ParseError> {
         self.nested(Self::term_inner)
     }
@@ -596,8 +620,8 @@ impl<'a> Parser<'a> {
             // A parenthesised disjunction, unless it is the start of an expression
             // in a comparison such as `(x + 1) < y`.
             let save = self.pos;
-            self.bump();
-            if let Ok(d) = self.disjunction() {
+            if let Some((end, d)) = self.group(save) {
+                self.pos = end;
                 if self.eat(")") && !self.is_cmp_op() && !self.is_arith_op() {
                     return Ok(d);
                 }
