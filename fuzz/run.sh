@@ -1,34 +1,37 @@
 #!/usr/bin/env bash
-# Coverage-guided fuzzing of framewright's readers with AFL++ (cargo-afl, stable Rust).
+# Coverage-guided fuzzing of framewright's readers with libFuzzer (cargo-fuzz).
 #
 #   fuzz/run.sh                      # every target, 1,000,000 executions each
 #   fuzz/run.sh --execs 50000        # every target, that many executions each
-#   fuzz/run.sh --seconds 5          # every target, that long each (the CI smoke run)
+#   fuzz/run.sh --seconds 20         # every target, that long each (the CI smoke run)
 #   fuzz/run.sh --seconds 60 urdf    # some targets only
 #
-# Targets run one after another at low priority. Findings land in fuzz/out/<target>/default/
-# {crashes,hangs}; the figures of the last run in fuzz/out/summary.md. Exits 1 when any target
-# found a crash or a hang, 2 when the tools are missing.
+# Targets run one after another at low priority, each from its seeds plus the corpus its
+# earlier runs kept (fuzz/out/corpus/<target>/). A finding (panic, abort, an input running
+# past 1 s, or past 1 GB) stops that target and lands in fuzz/out/findings/<target>/; the
+# figures of the last run of each target in fuzz/out/summary.md. Exits 1 when any target found
+# something, 2 when the tools are missing or the build failed.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
 shared="$root/../shared"
 
-budget=(-E 1000000)
+budget=(-runs=1000000)
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --execs) budget=(-E "$2"); shift 2 ;;
-    --seconds) budget=(-V "$2"); shift 2 ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    --execs) budget=("-runs=$2"); shift 2 ;;
+    --seconds) budget=("-max_total_time=$2"); shift 2 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
     -*) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(ifc rules_front rules_run cell_toml urdf)
+all=(ifc rules_front rules_run cell_toml urdf)
+[ ${#targets[@]} -gt 0 ] || targets=("${all[@]}")
 
-if ! cargo afl --version >/dev/null 2>&1; then
-  echo "cargo-afl is not installed: cargo install cargo-afl && cargo afl config --build" >&2
+if ! cargo fuzz --version >/dev/null 2>&1; then
+  echo "cargo-fuzz is not installed: cargo install cargo-fuzz" >&2
   exit 2
 fi
 
@@ -57,47 +60,69 @@ seed cell_toml '\x00' 16384 "$root"/robots/cells/*.toml "$root"/tests/fixtures/c
 seed cell_toml '\x01' 16384 "$root"/robots/tools/*.toml
 seed cell_toml '\x02' 16384 "$root"/robots/*.toml
 seed urdf "" 65536 "$root"/robots/*.urdf "$root"/tests/fixtures/robots/*.urdf
+# Inputs that once crashed a target seed it again.
+for t in "${all[@]}"; do
+  for f in "$root"/tests/fixtures/fuzz/"$t"/*; do
+    [ "${f##*.}" = md ] || cp "$f" "$here/out/seeds/$t/kept-$(basename "$f")"
+  done
+done
 
 declare -A dict=([ifc]="$here/dict/step.dict" [rules_front]="$here/dict/rules.dict" [rules_run]="$here/dict/rules.dict")
 
-(cd "$here" && CARGO_BUILD_JOBS="${CARGO_BUILD_JOBS:-1}" nice cargo afl build --release --bins)
-
-# No UI (logs instead), no CPU pinning (the cores are shared).
-export AFL_NO_UI=1 AFL_NO_AFFINITY=1 AFL_SKIP_CPUFREQ=1
-export AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1 AFL_SUPPRESS_WARNINGS=1
+# Release build with debug assertions and overflow checks; no sanitizer (safe Rust), so the
+# stable toolchain does.
+build=(-s none -O -a --fuzz-dir "$here")
+(cd "$here" && CARGO_BUILD_JOBS="${CARGO_BUILD_JOBS:-2}" nice cargo fuzz build "${build[@]}") \
+  || { echo "the fuzz build failed" >&2; exit 2; }
 
 found=0
 # An empty directory as the working directory: inputs that name relative files find nothing.
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-count() { ls "$1" 2>/dev/null | grep -vc README || true; }
 for t in "${targets[@]}"; do
   [ -n "$(ls -A "$here/out/seeds/$t" 2>/dev/null)" ] || { echo "no seeds for $t" >&2; exit 2; }
-  x=()
-  [ -n "${dict[$t]:-}" ] && x=(-x "${dict[$t]}")
+  opts=(-timeout=1 -rss_limit_mb=1024 -max_len=65536 -seed=1 -print_final_stats=1
+        "-artifact_prefix=$here/out/findings/$t/" "${budget[@]}")
+  [ -n "${dict[$t]:-}" ] && opts+=("-dict=${dict[$t]}")
+  mkdir -p "$here/out/corpus/$t" "$here/out/findings/$t"
   echo "== fuzzing $t (${budget[*]})"
-  rm -rf "$here/out/$t"
-  (cd "$work" && nice cargo afl fuzz "${budget[@]}" -t 1000 -m 1024 "${x[@]}" \
-     -i "$here/out/seeds/$t" -o "$here/out/$t" "$here/target/release/$t" > "$here/out/$t.log" 2>&1) \
-     || { echo "afl-fuzz failed for $t, see fuzz/out/$t.log" >&2; tail -20 "$here/out/$t.log" >&2; exit 2; }
-  [ "$(count "$here/out/$t/default/crashes")$(count "$here/out/$t/default/hangs")" = "00" ] || found=1
+  start=$(date +%s)
+  status=0
+  (cd "$work" && nice cargo fuzz run "${build[@]}" "$t" "$here/out/corpus/$t" "$here/out/seeds/$t" \
+     -- "${opts[@]}" > "$here/out/$t.log" 2>&1) || status=$?
+  echo "$(( $(date +%s) - start ))" > "$here/out/$t.seconds"
+  if [ "$status" != 0 ]; then
+    found=1
+    echo "$t stopped with a finding (exit $status): fuzz/out/$t.log" >&2
+    grep -E "^(==[0-9]+== ERROR|thread '.*' panicked|SUMMARY|artifact_prefix|Test unit written)" \
+      "$here/out/$t.log" | head -5 >&2 || true
+  fi
 done
 
 # The figures of the latest run of every target (also of earlier invocations).
 summary="$here/out/summary.md"
 {
-  echo "| target | executions | run time (s) | execs/s | edges found / map | corpus | crashes | hangs |"
+  echo "| target | executions | run time (s) | execs/s | coverage (edges) | features | corpus | findings |"
   echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
-  for t in ifc rules_front rules_run cell_toml urdf; do
-    stats="$here/out/$t/default/fuzzer_stats"
-    [ -f "$stats" ] || continue
-    get() { sed -n "s/^$1 *: *//p" "$stats"; }
-    echo "| $t | $(get execs_done) | $(get run_time) | $(get execs_per_sec) | $(get edges_found) / $(get total_edges) | $(get corpus_count) | $(count "$here/out/$t/default/crashes") | $(count "$here/out/$t/default/hangs") |"
+  for t in "${all[@]}"; do
+    log="$here/out/$t.log"
+    [ -f "$log" ] || continue
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+    # libFuzzer's own figure when it finished its runs; else the wall time of `cargo fuzz run`.
+    secs=$(sed -n 's/^Done [0-9]* runs in \([0-9]*\) second.*/\1/p' "$log" | tail -1)
+    [ -n "$secs" ] || secs=$(cat "$here/out/$t.seconds")
+    last=$(grep -E '^#[0-9]+' "$log" | tail -1)
+    cov=$(echo "$last" | sed -n 's/.* cov: \([0-9]*\).*/\1/p')
+    ft=$(echo "$last" | sed -n 's/.* ft: \([0-9]*\).*/\1/p')
+    corp=$(echo "$last" | sed -n 's/.* corp: \([0-9]*\).*/\1/p')
+    findings=$(find "$here/out/findings/$t" -type f 2>/dev/null | wc -l)
+    echo "| $t | ${runs:-?} | $secs | $(( ${runs:-0} / (secs > 0 ? secs : 1) )) | ${cov:-?} | ${ft:-?} | ${corp:-?} | $findings |"
   done
 } > "$summary"
 cat "$summary"
 if [ "$found" = 1 ]; then
-  echo "findings in fuzz/out/<target>/default/{crashes,hangs}: replay one with" \
-       "fuzz/target/release/<target> < FILE, then keep it in tests/fuzz_regressions.rs" >&2
+  echo "findings in fuzz/out/findings/<target>/: replay one with" \
+       "fuzz/target/x86_64-unknown-linux-gnu/release/<target> FILE, then keep it in" \
+       "tests/fixtures/fuzz/<target>/ (tests/fuzz_regressions.rs replays it)" >&2
   exit 1
 fi

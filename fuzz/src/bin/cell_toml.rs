@@ -1,4 +1,3 @@
-//! AFL++ target: see `framewright_fuzz::cell_toml`.
-fn main() {
-    afl::fuzz!(|data: &[u8]| framewright_fuzz::cell_toml(data));
-}
+//! libFuzzer target: see `framewright_fuzz::cell_toml`.
+#![no_main]
+libfuzzer_sys::fuzz_target!(|data: &[u8]| framewright_fuzz::cell_toml(data));

@@ -1,4 +1,3 @@
-//! AFL++ target: see `framewright_fuzz::ifc`.
-fn main() {
-    afl::fuzz!(|data: &[u8]| framewright_fuzz::ifc(data));
-}
+//! libFuzzer target: see `framewright_fuzz::ifc`.
+#![no_main]
+libfuzzer_sys::fuzz_target!(|data: &[u8]| framewright_fuzz::ifc(data));

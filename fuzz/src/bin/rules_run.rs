@@ -1,4 +1,3 @@
-//! AFL++ target: see `framewright_fuzz::rules_run`.
-fn main() {
-    afl::fuzz!(|data: &[u8]| framewright_fuzz::rules_run(data));
-}
+//! libFuzzer target: see `framewright_fuzz::rules_run`.
+#![no_main]
+libfuzzer_sys::fuzz_target!(|data: &[u8]| framewright_fuzz::rules_run(data));

@@ -1,4 +1,3 @@
-//! AFL++ target: see `framewright_fuzz::urdf`.
-fn main() {
-    afl::fuzz!(|data: &[u8]| framewright_fuzz::urdf(data));
-}
+//! libFuzzer target: see `framewright_fuzz::urdf`.
+#![no_main]
+libfuzzer_sys::fuzz_target!(|data: &[u8]| framewright_fuzz::urdf(data));
