@@ -141,11 +141,7 @@ impl Robot {
         options: &IkOptions,
     ) -> Result<Vec<Vec<f64>>, IkFailure> {
         assert_eq!(seed.len(), self.dof(), "seed length");
-        let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
-        if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
-            return Err(IkFailure::InvalidPose);
-        }
-        let target = pose * tcp.inverse();
+        let target = tip_target(pose, tcp)?;
         match &self.opw {
             Some(_) => Ok(self
                 .ik_closed_form(&target, seed, options, Variants::All)?
@@ -191,11 +187,7 @@ impl Robot {
         options: &IkOptions,
     ) -> Result<Vec<[f64; 6]>, IkFailure> {
         assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
-        let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
-        if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
-            return Err(IkFailure::InvalidPose);
-        }
-        let target = pose * tcp.inverse();
+        let target = tip_target(pose, tcp)?;
         match &self.opw {
             Some(_) => self.ik_closed_form(&target, seed, options, Variants::All),
             None => Ok(self
@@ -231,11 +223,7 @@ impl Robot {
         seed: &[f64; 6],
     ) -> Result<[f64; 6], IkFailure> {
         assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
-        let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
-        if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
-            return Err(IkFailure::InvalidPose);
-        }
-        let target = pose * tcp.inverse();
+        let target = tip_target(pose, tcp)?;
         let mut solutions = match &self.opw {
             Some(_) => {
                 self.ik_closed_form(&target, seed, &IkOptions::default(), Variants::Nearest)?
@@ -436,28 +424,48 @@ fn push_nearest_variant(
 ) {
     let mut best = [0.0f64; 6];
     for i in 0..6 {
-        let (lo, hi) = limits[i];
-        if !(lo.is_finite() && hi.is_finite()) {
-            best[i] = q[i];
-            continue;
-        }
-        let mut x = q[i] + 2.0 * PI * ((lo - q[i]) / (2.0 * PI)).ceil();
-        let mut chosen: Option<f64> = None;
-        let mut count = 0;
-        while x <= hi + 1e-12 && count < 4 {
-            let v = x.clamp(lo, hi);
-            if chosen.is_none_or(|c| (v - seed[i]).powi(2) < (c - seed[i]).powi(2)) {
-                chosen = Some(v);
+        let (copies, count) = turn_copies(q[i], limits[i]);
+        let Some(&first) = copies[..count].first() else {
+            return;
+        };
+        // The first of equals, as the sort by distance (ties by generation order) keeps.
+        best[i] = copies[..count].iter().fold(first, |c, &v| {
+            if (v - seed[i]).powi(2) < (c - seed[i]).powi(2) {
+                v
+            } else {
+                c
             }
-            count += 1;
-            x += 2.0 * PI;
-        }
-        match chosen {
-            Some(v) => best[i] = v,
-            None => return,
-        }
+        });
     }
     out.push((best, wrist));
+}
+
+/// The copies of one joint value shifted by whole turns that fit its limits, in increasing
+/// order: up to 4 (a range of up to 3 turns, e.g. ±400°, holds at most 3). A continuous
+/// joint's wrapped value stands for all its turns.
+fn turn_copies(v: f64, (lo, hi): (f64, f64)) -> ([f64; 4], usize) {
+    let mut copies = [0.0f64; 4];
+    if !(lo.is_finite() && hi.is_finite()) {
+        copies[0] = v;
+        return (copies, 1);
+    }
+    let mut count = 0;
+    let mut x = v + 2.0 * PI * ((lo - v) / (2.0 * PI)).ceil();
+    while x <= hi + 1e-12 && count < 4 {
+        copies[count] = x.clamp(lo, hi);
+        count += 1;
+        x += 2.0 * PI;
+    }
+    (copies, count)
+}
+
+/// The tool0 pose that puts `tcp` on `pose`; Err(InvalidPose) when either is not finite.
+fn tip_target(pose: &Isometry3<f64>, tcp: &Isometry3<f64>) -> Result<Isometry3<f64>, IkFailure> {
+    let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
+    if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
+        return Err(IkFailure::InvalidPose);
+    }
+    Ok(pose * tcp.inverse())
 }
 
 /// Push every copy of `q` shifted by whole turns that fits the limits (all joints revolute).
@@ -467,23 +475,10 @@ fn push_turn_variants(
     wrist: f64,
     out: &mut Vec<([f64; 6], f64)>,
 ) {
-    // Per joint, up to 4 values (a range of up to 3 turns, e.g. ±400°, holds at most 3).
     let mut options = [[0.0f64; 4]; 6];
     let mut counts = [0usize; 6];
     for i in 0..6 {
-        let (lo, hi) = limits[i];
-        if !(lo.is_finite() && hi.is_finite()) {
-            // Continuous joint: the wrapped value stands for all turns.
-            options[i][0] = q[i];
-            counts[i] = 1;
-            continue;
-        }
-        let mut x = q[i] + 2.0 * PI * ((lo - q[i]) / (2.0 * PI)).ceil();
-        while x <= hi + 1e-12 && counts[i] < 4 {
-            options[i][counts[i]] = x.clamp(lo, hi);
-            counts[i] += 1;
-            x += 2.0 * PI;
-        }
+        (options[i], counts[i]) = turn_copies(q[i], limits[i]);
         if counts[i] == 0 {
             return;
         }
