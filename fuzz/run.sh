@@ -3,26 +3,29 @@
 #
 #   fuzz/run.sh                      # every target, 1,000,000 executions each
 #   fuzz/run.sh --execs 50000        # every target, that many executions each
-#   fuzz/run.sh --seconds 20         # every target, that long each (the CI smoke run)
+#   fuzz/run.sh --seconds 20         # every target, that long each
 #   fuzz/run.sh --seconds 60 urdf    # some targets only
+#   fuzz/run.sh --timeout 5 ...      # a slow input is one past 5 s (default 1 s)
 #
 # Targets run one after another at low priority, each from its seeds plus the corpus its
 # earlier runs kept (fuzz/out/corpus/<target>/). A finding (panic, abort, an input running
 # past 1 s, or past 1 GB) stops that target and lands in fuzz/out/findings/<target>/; the
 # figures of the last run of each target in fuzz/out/summary.md. Exits 1 when any target found
-# something, 2 when the tools are missing or the build failed.
+# something, 2 when cargo-fuzz is missing, 3 when the build failed.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
 shared="$root/../shared"
 
 budget=(-runs=1000000)
+timeout=1
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --execs) budget=("-runs=$2"); shift 2 ;;
     --seconds) budget=("-max_total_time=$2"); shift 2 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    --timeout) timeout="$2"; shift 2 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     -*) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
     *) targets+=("$1"); shift ;;
   esac
@@ -73,7 +76,8 @@ declare -A dict=([ifc]="$here/dict/step.dict" [rules_front]="$here/dict/rules.di
 # stable toolchain does.
 build=(-s none -O -a --fuzz-dir "$here")
 (cd "$here" && CARGO_BUILD_JOBS="${CARGO_BUILD_JOBS:-2}" nice cargo fuzz build "${build[@]}") \
-  || { echo "the fuzz build failed" >&2; exit 2; }
+  || { echo "the fuzz build failed" >&2; exit 3; }
+bin_dir="$here/target/$(rustc -vV | sed -n 's/^host: //p')/release"
 
 found=0
 # An empty directory as the working directory: inputs that name relative files find nothing.
@@ -81,15 +85,17 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 for t in "${targets[@]}"; do
   [ -n "$(ls -A "$here/out/seeds/$t" 2>/dev/null)" ] || { echo "no seeds for $t" >&2; exit 2; }
-  opts=(-timeout=1 -rss_limit_mb=1024 -max_len=65536 -seed=1 -print_final_stats=1
+  opts=("-timeout=$timeout" -rss_limit_mb=1024 -max_len=65536 -seed=1 -print_final_stats=1
         "-artifact_prefix=$here/out/findings/$t/" "${budget[@]}")
   [ -n "${dict[$t]:-}" ] && opts+=("-dict=${dict[$t]}")
   mkdir -p "$here/out/corpus/$t" "$here/out/findings/$t"
   echo "== fuzzing $t (${budget[*]})"
   start=$(date +%s)
   status=0
-  (cd "$work" && nice cargo fuzz run "${build[@]}" "$t" "$here/out/corpus/$t" "$here/out/seeds/$t" \
-     -- "${opts[@]}" > "$here/out/$t.log" 2>&1) || status=$?
+  # The binary built above, run directly: `cargo fuzz run` would rebuild it whenever a source
+  # file changed during the run, mid-way through the targets.
+  (cd "$work" && nice "$bin_dir/$t" "$here/out/corpus/$t" "$here/out/seeds/$t" \
+     "${opts[@]}" > "$here/out/$t.log" 2>&1) || status=$?
   echo "$(( $(date +%s) - start ))" > "$here/out/$t.seconds"
   if [ "$status" != 0 ]; then
     found=1
