@@ -124,8 +124,13 @@ pub struct Physics {
     /// gripped, released, clamped, nailed; jaws; belts): a clearance measured at one count
     /// holds only at that count.
     generation: u64,
+    /// Counts the changes that may set lumber moving: all but a piece starting to ride (it
+    /// moves at its belt's speed, touching nothing). Settling is judged from the last one.
+    disturbances: u64,
     /// Pieces riding a running belt as kinematic bodies (see `start_ride`).
     riding: BTreeSet<String>,
+    /// Where `advance_rides` last put each rider, unrounded.
+    ride_exact: HashMap<String, Vector3<f64>>,
 }
 
 /// How far the robot, its tool and a held piece are from the rest of the world (m), each
@@ -380,13 +385,31 @@ impl Physics {
             lumber_of: HashMap::new(),
             cell: cell.clone(),
             generation: 0,
+            disturbances: 0,
             riding: BTreeSet::new(),
+            ride_exact: HashMap::new(),
         }
     }
 
     /// Puts a lumber piece into the world at `pose` (cell frame), at rest.
     pub fn add_lumber(&mut self, piece: &ScenePiece, pose: &Isometry3<f64>) {
-        self.generation += 1;
+        self.insert_lumber(piece, pose, true);
+    }
+
+    /// Puts a piece onto a running belt riding it from the start (see `start_ride`): it
+    /// touches nothing, so nothing in the world has to settle.
+    pub fn add_riding(
+        &mut self,
+        piece: &ScenePiece,
+        pose: &Isometry3<f64>,
+        velocity: &Vector3<f64>,
+    ) {
+        self.insert_lumber(piece, pose, false);
+        self.start_ride(&piece.id, velocity);
+    }
+
+    fn insert_lumber(&mut self, piece: &ScenePiece, pose: &Isometry3<f64>, disturbs: bool) {
+        self.changed(disturbs);
         let [l, w, t] = piece.size.map(|v| v as f32 / 2.0);
         // Lumber on a belt never sleeps: the slow infeed belt moves it below rapier's sleep
         // threshold. Placed pieces may sleep again (see `detach`).
@@ -420,7 +443,7 @@ impl Physics {
         if !self.riding.insert(id.to_string()) {
             return;
         }
-        self.generation += 1;
+        self.changed(false);
         let body = &mut self.world.bodies[b.body];
         body.set_body_type(RigidBodyType::KinematicVelocityBased, true);
         body.set_angvel(Vector::ZERO, true);
@@ -438,10 +461,11 @@ impl Physics {
         if !self.riding.remove(id) {
             return;
         }
+        self.ride_exact.remove(id);
         let Some(b) = self.lumber.get(id).copied() else {
             return;
         };
-        self.generation += 1;
+        self.changed(true);
         let body = &mut self.world.bodies[b.body];
         let velocity = body.linvel();
         body.set_body_type(RigidBodyType::Dynamic, true);
@@ -451,10 +475,60 @@ impl Physics {
         }
     }
 
+    /// Whether a piece rides its belt (see `start_ride`).
+    pub fn is_riding(&self, id: &str) -> bool {
+        self.riding.contains(id)
+    }
+
+    /// The fastest riding piece's speed (m/s), 0 with none riding.
+    pub fn ride_speed(&self) -> f64 {
+        self.riding
+            .iter()
+            .filter_map(|id| self.lumber.get(id))
+            .map(|b| f64::from(self.world.bodies[b.body].linvel().length()))
+            .fold(0.0, f64::max)
+    }
+
+    /// Moves every riding piece as a step would (position += velocity · dt, in rapier's f32),
+    /// without the solver: a rider has no contacts to solve. rapier's own structures (broad
+    /// phase, contacts) see the new positions at the next step or `detect`; `clearance`
+    /// measures riders where they are.
+    pub fn advance_rides(&mut self, dt: f64) {
+        for id in &self.riding {
+            let Some(b) = self.lumber.get(id) else {
+                continue;
+            };
+            let body = &mut self.world.bodies[b.body];
+            // Summed in f64 from where the last advance left it (unless a solver step moved
+            // it since), then rounded: adding the same small step in f32 rounds the same way
+            // every time, a drift of millimetres over a long ride.
+            let v = body.linvel();
+            let mut pose = to_iso(body.position());
+            let unmoved = |exact: &Vector3<f64>| {
+                let rounded = Isometry3::from_parts(Translation3::from(*exact), pose.rotation);
+                to_pose(&rounded).translation == body.position().translation
+            };
+            if let Some(exact) = self.ride_exact.get(id)
+                && unmoved(exact)
+            {
+                pose.translation.vector = *exact;
+            }
+            pose.translation.vector += Vector3::new(v.x.into(), v.y.into(), v.z.into()) * dt;
+            match self.ride_exact.get_mut(id) {
+                Some(exact) => *exact = pose.translation.vector,
+                None => {
+                    self.ride_exact.insert(id.clone(), pose.translation.vector);
+                }
+            }
+            body.set_position(to_pose(&pose), false);
+        }
+    }
+
     /// Takes a piece out of the world (an operator lifts it off the belt).
     pub fn remove_lumber(&mut self, id: &str) {
         self.riding.remove(id);
-        self.generation += 1;
+        self.ride_exact.remove(id);
+        self.changed(true);
         if let Some(b) = self.lumber.remove(id) {
             self.world.remove_body_with_colliders(b.body, true);
             self.lumber_of.remove(&b.collider);
@@ -496,7 +570,7 @@ impl Physics {
     /// A framing table under the wall when the cell's assembly surface is above the floor:
     /// a solid block from the floor to `top` over the cell-frame rectangle `min`..`max`.
     pub fn add_assembly_table(&mut self, min: [f64; 2], max: [f64; 2], top: f64) {
-        self.generation += 1;
+        self.changed(true);
         let floor = self.cell.floor.z;
         let height = top - floor;
         if height <= 0.0 {
@@ -521,7 +595,7 @@ impl Physics {
 
     /// Opens the jaws (`None`) or closes them on lumber of this thickness.
     pub fn set_jaws(&mut self, closed_on: Option<f64>) {
-        self.generation += 1;
+        self.changed(true);
         let open = self
             .cell
             .tool
@@ -538,7 +612,7 @@ impl Physics {
 
     /// Holds a piece rigidly in the gripper: it becomes position-driven (it follows the tool).
     pub fn attach(&mut self, id: &str) {
-        self.generation += 1;
+        self.changed(true);
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::KinematicPositionBased, true);
         }
@@ -546,7 +620,7 @@ impl Physics {
 
     /// Lets go of a piece: it is a dynamic body again, at rest where it is.
     pub fn detach(&mut self, id: &str) {
-        self.generation += 1;
+        self.changed(true);
         if let Some(b) = self.lumber.get(id) {
             let body = &mut self.world.bodies[b.body];
             body.set_body_type(RigidBodyType::Dynamic, true);
@@ -563,7 +637,7 @@ impl Physics {
     /// The fixture holds a placed piece where it came to rest (a framing table's stops and
     /// clamps): it no longer moves, whatever touches it later.
     pub fn clamp(&mut self, id: &str) {
-        self.generation += 1;
+        self.changed(true);
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::Fixed, true);
         }
@@ -578,7 +652,7 @@ impl Physics {
 
     /// Joins two pieces where they are (a nail).
     pub fn nail(&mut self, a: &str, b: &str) {
-        self.generation += 1;
+        self.changed(true);
         let (Some(a), Some(b)) = (self.lumber.get(a).copied(), self.lumber.get(b).copied()) else {
             return;
         };
@@ -593,7 +667,7 @@ impl Physics {
 
     /// Starts or stops both belts; a started belt wakes the lumber on it.
     pub fn set_belts(&mut self, running: bool) {
-        self.generation += 1;
+        self.changed(true);
         if !running {
             let riding: Vec<String> = self.riding.iter().cloned().collect();
             for id in riding {
@@ -620,6 +694,18 @@ impl Physics {
     /// The count of changes to the world's contents (see `generation`).
     pub fn generation(&self) -> u64 {
         self.generation
+    }
+
+    /// The count of changes that may set lumber moving (see `disturbances`).
+    pub fn disturbances(&self) -> u64 {
+        self.disturbances
+    }
+
+    fn changed(&mut self, disturbs: bool) {
+        self.generation += 1;
+        if disturbs {
+            self.disturbances += 1;
+        }
     }
 
     /// Puts the robot's bodies (and the held piece, at `in_tool` in tool0) at joint values
@@ -729,8 +815,18 @@ impl Physics {
         if let Some(b) = held.and_then(|(id, _)| self.lumber.get(id)) {
             own.push(b.body);
         }
+        // Riders are measured apart, where they are now: between steps the broad phase holds
+        // them where the last step left them.
+        let riders: Vec<LumberBody> = self
+            .riding
+            .iter()
+            .filter_map(|id| self.lumber.get(id).copied())
+            .collect();
         let predicate = |_: ColliderHandle, c: &Collider| {
-            !c.is_sensor() && !c.parent().is_some_and(|b| own.contains(&b))
+            !c.is_sensor()
+                && !c
+                    .parent()
+                    .is_some_and(|b| own.contains(&b) || riders.iter().any(|r| r.body == b))
         };
         let mut found = Clearance {
             any: reach,
@@ -761,6 +857,22 @@ impl Physics {
                 if loose {
                     found.loose = found.loose.min(d);
                 }
+            }
+            // A rider moves on its own: it counts as loose.
+            for r in &riders {
+                if !collider
+                    .collision_groups()
+                    .test(self.world.colliders[r.collider].collision_groups())
+                {
+                    continue;
+                }
+                let other = &self.world.colliders[r.collider];
+                let at = *self.world.bodies[r.body].position()
+                    * *other.position_wrt_parent().unwrap_or(&Pose::IDENTITY);
+                let d = rapier3d::parry::query::distance(&pose, shape, &at, other.shape())
+                    .map_or(0.0, |d| f64::from(d.distance).min(reach));
+                found.any = found.any.min(d);
+                found.loose = found.loose.min(d);
             }
         }
         found
@@ -936,5 +1048,64 @@ mod tests {
         phys.set_belts(false);
         assert!(phys.world.bodies[body].is_dynamic());
         assert!(phys.lumber_speed("p").expect("piece").0 < 1e-9);
+    }
+
+    #[test]
+    fn advancing_a_ride_without_the_solver_moves_it_as_steps_do_and_clearance_sees_it_there() {
+        let cell = Cell::load("study-abb").expect("cell");
+        let dt = 1.0 / 240.0;
+        let velocity = cell.conveyor1.direction() * cell.conveyor1.speed;
+        let ride = |advance: bool| {
+            let mut phys = Physics::new(&cell, &cell.robot.home(), dt);
+            let (piece, pose) = piece_on_deck(&cell);
+            phys.add_lumber(&piece, &pose);
+            phys.set_belts(true);
+            phys.start_ride("p", &velocity);
+            for _ in 0..480 {
+                if advance {
+                    phys.advance_rides(dt);
+                } else {
+                    phys.step();
+                }
+            }
+            phys
+        };
+        let stepped = ride(false).lumber_pose("p").expect("piece");
+        let advanced_world = ride(true);
+        let advanced = advanced_world.lumber_pose("p").expect("piece");
+        let expected = (velocity * 480.0 * dt).norm();
+        assert!(expected > 0.05, "the ride covers {expected} m");
+        // Against the belt's travel: the advanced ride is off by the f32 rounding of its
+        // start and end (not per step); the stepped one within rapier's per-step rounding.
+        let start = piece_on_deck(&cell).1.translation.vector;
+        let error = |pose: &Isometry3<f64>| {
+            (pose.translation.vector - start - velocity * 480.0 * dt).norm()
+        };
+        let ulp = f64::from(f32::EPSILON) * advanced.translation.vector.amax();
+        assert!(
+            error(&advanced) < 4.0 * ulp,
+            "advanced ride off by {}",
+            error(&advanced)
+        );
+        assert!(
+            error(&stepped) < 480.0 * 2.0 * ulp,
+            "stepped ride off by {}",
+            error(&stepped)
+        );
+        assert!((advanced_world.ride_speed() - cell.conveyor1.speed).abs() < 1e-6);
+        // The rider counts as loose where it is now, not where the broad phase last saw it:
+        // its distance to the robot at home equals that of a world stepped to the same place.
+        let home = cell.robot.home();
+        let measured = |phys: &Physics| phys.clearance(&home, None, 100.0);
+        let (a, b) = (measured(&ride(false)), measured(&advanced_world));
+        // (within the stepped ride's rounding; the broad phase's stale place is the whole
+        // ride, 0.1 m, away)
+        assert!(
+            (a.loose - b.loose).abs() < 1e-3,
+            "{} vs {}",
+            a.loose,
+            b.loose
+        );
+        assert!(b.loose < 100.0);
     }
 }

@@ -11,8 +11,9 @@ use std::collections::HashMap;
 /// A piece this close to conveyor 1's stop rail is at the rail (m).
 const TRANSFER_REACH: f64 = 0.005;
 /// A piece on conveyor 1 rides it without the solver while nothing lies within this ahead of
-/// it (m): 1 s of travel at the study's 0.05 m/s, time for it to settle against what it meets.
-const RIDE_CLEARANCE: f64 = 0.05;
+/// it (m): 0.2 s of travel at the study's 0.05 m/s. The rest of the way it is a dynamic body
+/// and meets what is ahead under the solver.
+const RIDE_CLEARANCE: f64 = 0.01;
 
 impl<'a> WallRun<'a> {
     /// Puts every piece whose spawn pose lies on conveyor 1 there; the rest wait in the queue.
@@ -47,22 +48,34 @@ impl<'a> WallRun<'a> {
         let Some(next) = self.queue.front().copied() else {
             return;
         };
+        // After a look that found the belt short of clear, the next is due when it can be.
+        let state = self.belt_state();
+        if let Some((seen, due)) = self.feed_due
+            && seen == state
+            && self.t < due
+        {
+            return;
+        }
         // How much of the belt's travel it takes up (its length end to end, its thickness
         // side by side).
         let direction = self.cell.conveyor1.direction();
         let local = next.spawn.rotation.inverse() * direction;
         let length: f64 = (0..3).map(|i| local[i].abs() * next.size[i]).sum();
-        let clear = self.on_belts.iter().all(|id| {
-            let Some(pose) = self.phys.lumber_pose(id) else {
-                return true;
-            };
-            let centre = self.belt1_position(&pose.translation.vector);
-            let half = piece_half_along(&pose, &self.cell.conveyor1.direction(), id, &self.sizes);
-            centre - half >= length + self.cell.lumber_gap
-        });
-        if !clear {
+        let shortfall = self
+            .on_belts
+            .iter()
+            .filter_map(|id| {
+                let pose = self.phys.lumber_pose(id)?;
+                let centre = self.belt1_position(&pose.translation.vector);
+                let half = piece_half_along(&pose, &direction, id, &self.sizes);
+                Some(length + self.cell.lumber_gap - (centre - half))
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        if shortfall > 0.0 {
+            self.feed_due = Some((state, self.due_after(shortfall)));
             return;
         }
+        self.feed_due = None;
         // Its queue pose moved upstream-end first onto the belt.
         let at = self.belt1_position(&next.spawn.translation.vector);
         let shift = self.cell.conveyor1.direction() * (length / 2.0 - at);
@@ -71,8 +84,37 @@ impl<'a> WallRun<'a> {
             next.spawn.rotation,
         );
         self.queue.pop_front();
-        self.phys.add_lumber(next, &pose);
+        // With room ahead (the gap to the piece in front, the belt to its end) it rides from
+        // the start, as `update_rides` would have it after its next look.
+        let c1 = &self.cell.conveyor1;
+        let room = self.cell.lumber_gap.min(c1.length - length);
+        if self.phys.belts.running && room > RIDE_CLEARANCE {
+            self.phys.add_riding(next, &pose, &(direction * c1.speed));
+        } else {
+            self.phys.add_lumber(next, &pose);
+        }
         self.on_belts.insert(next.id.clone());
+    }
+
+    /// What the feeder's looks depend on besides the belt's travel: the world's change count
+    /// and the lumber on the belts.
+    fn belt_state(&self) -> (u64, usize) {
+        (self.phys.generation(), self.on_belts.len())
+    }
+
+    /// The time a look that found conveyor 1 short of its mark by `shortfall` (m) is next due:
+    /// nothing on it moves faster than its belt.
+    fn due_after(&self, shortfall: f64) -> f64 {
+        let speed = if self.phys.belts.running {
+            self.cell.conveyor1.speed
+        } else {
+            0.0
+        };
+        if speed > 0.0 {
+            self.t + shortfall / speed - self.options.dt
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// Pieces on conveyor 1 with nothing within RIDE_CLEARANCE ahead of them (the next piece
@@ -137,28 +179,40 @@ impl<'a> WallRun<'a> {
         if !self.phys.belts.running {
             return;
         }
+        let state = self.belt_state();
+        if let Some((seen, due)) = self.transfer_due
+            && seen == state
+            && self.t < due
+        {
+            return;
+        }
         let c1 = &self.cell.conveyor1;
         let c2 = &self.cell.conveyor2;
         let on_conveyor2 =
             |pose: &Isometry3<f64>| c2.covers(&Point3::from(pose.translation.vector));
         let mut at_rail = None;
+        let mut shortfall = f64::INFINITY;
         for id in &self.on_belts {
             let Some(pose) = self.phys.lumber_pose(id) else {
                 continue;
             };
             if self.transferred.contains(id) || on_conveyor2(&pose) {
                 if self.transferred.contains(id) {
-                    return; // conveyor 2 is busy
+                    // Conveyor 2 is busy until that piece leaves the belts.
+                    self.transfer_due = Some((state, f64::INFINITY));
+                    return;
                 }
                 continue;
             }
             let half = piece_half_along(&pose, &c1.direction(), id, &self.sizes);
             let front = self.belt1_position(&pose.translation.vector) + half;
+            shortfall = shortfall.min(c1.length - TRANSFER_REACH - front);
             if at_rail.is_none() && front >= c1.length - TRANSFER_REACH {
                 at_rail = Some((id.clone(), pose));
             }
         }
         let Some((id, pose)) = at_rail else {
+            self.transfer_due = Some((state, self.due_after(shortfall)));
             return;
         };
         let Some(piece) = self.pieces.iter().copied().find(|p| p.id == id) else {

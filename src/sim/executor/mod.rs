@@ -53,6 +53,10 @@ pub struct WallRun<'a> {
     pieces: Vec<&'a ScenePiece>,
     /// Each piece's size by id (the feeder looks them up every step).
     sizes: HashMap<String, [f64; 3]>,
+    /// When the feeder looks at conveyor 1 next: (`belt_state`, time in s).
+    feed_due: Option<((u64, usize), f64)>,
+    /// When the transfer arm looks at conveyor 1's rail next (as `feed_due`).
+    transfer_due: Option<((u64, usize), f64)>,
     t: f64,
     q: Vec<f64>,
     held: Option<Held>,
@@ -101,6 +105,8 @@ impl<'a> WallRun<'a> {
             phys,
             wall_cell: cell.robot_base * wall.wall_to_robot,
             sizes: pieces.iter().map(|p| (p.id.clone(), p.size)).collect(),
+            feed_due: None,
+            transfer_due: None,
             pieces,
             t: 0.0,
             q: q.clone(),

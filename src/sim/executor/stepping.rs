@@ -1,6 +1,7 @@
 //! Event-driven stepping. rapier's solver only matters while lumber can move on its own:
-//! pieces riding a running belt, settling after they were fed, stopped or released, or pushed
-//! by the robot. The rest of a run (the robot carrying a piece through free space, nailing a
+//! pieces on a running belt that do not merely ride it (see `start_ride`), settling after
+//! they were fed, stopped or released, or pushed by the robot; riders advance at their belt's
+//! speed without it. The rest of a run (the robot carrying a piece through free space, nailing a
 //! clamped frame, waiting with nothing loose) advances time without the solver: the robot's
 //! joints follow their motion profile tick by tick as before, the pose trace is sampled at
 //! its rate, and the robot's contacts are found where a fixed-step run would find them.
@@ -35,8 +36,8 @@ const TOUCH: f64 = 1e-4;
 pub(super) struct Events {
     /// Consecutive solver steps with all lumber at rest since the world last changed.
     calm_steps: u32,
-    /// The world's change count those steps were counted at.
-    generation: u64,
+    /// The world's count of disturbances those steps were counted at.
+    disturbances: u64,
     /// The previous tick's joint values: rapier reports a step's contacts for where the
     /// bodies stood when it began, one tick behind the joints it drives them to.
     prev_q: Vec<f64>,
@@ -52,13 +53,15 @@ struct Anchor {
     free: f64,
     generation: u64,
     held: Option<String>,
+    /// When it was measured (s): riders have moved since.
+    t: f64,
 }
 
 impl Events {
     pub(super) fn new(q: &[f64]) -> Events {
         Events {
             calm_steps: 0,
-            generation: u64::MAX,
+            disturbances: u64::MAX,
             prev_q: q.to_vec(),
             anchor: None,
         }
@@ -81,14 +84,17 @@ impl<'a> WallRun<'a> {
         let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
         let corners = self.phys.robot_corners(&at, held_ref);
         let generation = self.phys.generation();
+        let ride_speed = self.phys.ride_speed();
         let within = self.events.anchor.as_ref().is_some_and(|a| {
+            // The robot and a rider may close the gap from both sides.
+            let ridden = ride_speed * (self.t - a.t + self.options.dt);
             a.generation == generation
                 && a.held.as_deref() == held_ref.map(|h| h.0)
                 && a.corners.len() == corners.len()
                 && a.corners
                     .iter()
                     .zip(&corners)
-                    .all(|(p, n)| (n - p).norm() < a.free)
+                    .all(|(p, n)| (n - p).norm() + ridden < a.free)
         });
         let mut touching = false;
         if !within {
@@ -104,26 +110,29 @@ impl<'a> WallRun<'a> {
                 free: clear.any.min(clear.loose - LOOSE_MARGIN),
                 generation,
                 held: held_ref.map(|h| h.0.to_string()),
+                t: self.t,
             });
         }
         self.quiet_tick(touching);
     }
 
-    /// Whether nothing in the world moves unless the robot pushes it: no lumber on running
-    /// belts, and every piece at rest for CALM_STEPS solver steps since the last change.
+    /// Whether nothing in the world moves unless the robot pushes it, or rides a belt: the
+    /// lumber on running belts all rides (a rider moves at its belt's speed, without
+    /// contacts), and every other piece at rest for CALM_STEPS solver steps since the last
+    /// change.
     fn world_quiet(&self) -> bool {
-        (!self.phys.belts.running || self.on_belts.is_empty())
-            && self.events.generation == self.phys.generation()
+        (!self.phys.belts.running || self.on_belts.iter().all(|id| self.phys.is_riding(id)))
+            && self.events.disturbances == self.phys.disturbances()
             && self.events.calm_steps >= CALM_STEPS
     }
 
     /// A step with the solver (the robot's bodies stand where the last tick left them).
     fn solver_tick(&mut self) {
-        let generation = self.phys.generation();
+        let disturbances = self.phys.disturbances();
         self.step();
         self.events.prev_q.clone_from(&self.q);
-        if self.phys.generation() != generation || self.events.generation != generation {
-            self.events.generation = self.phys.generation();
+        if self.phys.disturbances() != disturbances || self.events.disturbances != disturbances {
+            self.events.disturbances = self.phys.disturbances();
             self.events.calm_steps = 0;
         }
         if self.phys.lumber_calm(CALM_LINEAR, CALM_ANGULAR) {
@@ -147,6 +156,7 @@ impl<'a> WallRun<'a> {
             self.phys.detect();
         }
         self.phys.place_robot(&self.q, held_ref);
+        self.phys.advance_rides(self.options.dt);
         self.t += self.options.dt;
         self.sample_trace();
         if touching && watched {
