@@ -5,7 +5,7 @@
 //! rapier works in f32 with glam types; the rest of framewright in f64 with nalgebra. The
 //! conversions live here.
 
-use crate::cell::{Arrangement, Cell, PlacedShape, Shape};
+use crate::cell::{Arrangement, Cell, JointKind, PlacedShape, Shape};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
@@ -802,6 +802,43 @@ impl Physics {
         corners
     }
 
+    /// Per joint of `q`, a bound on how far any of `corners` (cell frame, at joint values `q`)
+    /// moves per unit of that joint's motion while they all move less than `slack` (m): for a
+    /// revolute joint the corners' largest distance from a point of its axis plus `slack` (m
+    /// per rad), for a prismatic one 1. Summed over |Δq|, it bounds every corner's motion
+    /// without forward kinematics.
+    pub fn robot_levers(&self, q: &[f64], corners: &[Vector3<f64>], slack: f64) -> Vec<f64> {
+        let robot = &self.cell.robot;
+        let poses = robot.fk_all(q);
+        let mut levers = vec![0.0; q.len()];
+        for joint in &robot.joints {
+            let Some(i) = joint.dof_index else {
+                continue;
+            };
+            levers[i] = match joint.kind {
+                JointKind::Prismatic => 1.0,
+                JointKind::Fixed => 0.0,
+                JointKind::Revolute | JointKind::Continuous => {
+                    // The child frame's origin lies on the joint's axis.
+                    let origin = (self.cell.robot_base * poses[joint.child])
+                        .translation
+                        .vector;
+                    let far = corners
+                        .iter()
+                        .map(|c| (c - origin).norm())
+                        .fold(0.0, f64::max);
+                    far + slack
+                }
+            };
+        }
+        levers
+    }
+
+    /// Where the robot's base stands (it moves with a carriage).
+    pub fn robot_base(&self) -> Isometry3<f64> {
+        self.cell.robot_base
+    }
+
     /// How far the robot, its tool and the held piece at joint values `q` are from everything
     /// else they can touch, and from loose lumber; distances beyond `reach` read as `reach`.
     pub fn clearance(
@@ -1107,5 +1144,40 @@ mod tests {
             b.loose
         );
         assert!(b.loose < 100.0);
+    }
+
+    #[test]
+    fn joint_levers_bound_how_far_every_corner_moves() {
+        for name in ["study-abb", "study-kuka"] {
+            let cell = Cell::load(name).expect("cell");
+            let phys = Physics::new(&cell, &cell.robot.home(), 1.0 / 240.0);
+            let home = cell.robot.home();
+            let corners = phys.robot_corners(&home, None);
+            let slack = 0.10;
+            let levers = phys.robot_levers(&home, &corners, slack);
+            // Small moves of every joint together, both ways: each corner moves no further
+            // than the bound while the bound stays under the slack.
+            for k in 0..200 {
+                let dq: Vec<f64> = (0..home.len())
+                    .map(|j| 0.004 * (((k * 7 + j * 3) % 11) as f64 - 5.0) / 5.0)
+                    .collect();
+                let q: Vec<f64> = home.iter().zip(&dq).map(|(a, d)| a + d).collect();
+                let bound: f64 = dq.iter().zip(&levers).map(|(d, l)| d.abs() * l).sum();
+                if bound >= slack {
+                    continue;
+                }
+                let moved = phys
+                    .robot_corners(&q, None)
+                    .iter()
+                    .zip(&corners)
+                    .map(|(a, b)| (a - b).norm())
+                    .fold(0.0, f64::max);
+                assert!(
+                    moved <= bound + 1e-9,
+                    "{name}: moved {moved} > bound {bound}"
+                );
+                assert!(moved > 0.0);
+            }
+        }
     }
 }

@@ -8,14 +8,16 @@
 //!
 //! Contacts without the solver: the distances from the robot, its tool and the held piece to
 //! everything else are measured at a pose; no point of them comes closer than that until
-//! they have moved that far (measured at the corners of their bounding boxes), so nothing
-//! more is measured until then. Where they touch something, rapier's collision detection
+//! they have moved that far, so nothing more is measured until then. How far they have moved
+//! is bounded without forward kinematics: per joint, |Δq| times the largest distance from its
+//! axis to a corner of their bounding boxes (a rotation by θ moves a point at distance r at
+//! most θ·r). Where they touch something, rapier's collision detection
 //! runs (no time passes) and the contacts are recorded as a fixed-step run records them.
 //! Near loose lumber (within LOOSE_MARGIN) the solver steps: the robot may push it.
 
 use super::WallRun;
 use crate::sim::Stepping;
-use nalgebra::Vector3;
+use nalgebra::Isometry3;
 
 /// Lumber slower than this is at rest (m/s, rad/s).
 const CALM_LINEAR: f64 = 2e-4;
@@ -47,7 +49,11 @@ pub(super) struct Events {
 
 #[derive(Debug, Clone)]
 struct Anchor {
-    corners: Vec<Vector3<f64>>,
+    /// The joints and the base it was measured at, and per joint how far the robot's
+    /// corners move per unit of its motion at most (`Physics::robot_levers`).
+    q: Vec<f64>,
+    base: Isometry3<f64>,
+    levers: Vec<f64>,
     /// How far the corners may move before something could be touched or loose lumber
     /// come within LOOSE_MARGIN (m).
     free: f64,
@@ -82,19 +88,22 @@ impl<'a> WallRun<'a> {
         let at = self.events.prev_q.clone();
         let held = self.held.clone();
         let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
-        let corners = self.phys.robot_corners(&at, held_ref);
         let generation = self.phys.generation();
+        let base = self.phys.robot_base();
         let ride_speed = self.phys.ride_speed();
         let within = self.events.anchor.as_ref().is_some_and(|a| {
             // The robot and a rider may close the gap from both sides.
             let ridden = ride_speed * (self.t - a.t + self.options.dt);
+            let moved: f64 =
+                a.q.iter()
+                    .zip(&at)
+                    .zip(&a.levers)
+                    .map(|((from, to), lever)| (to - from).abs() * lever)
+                    .sum();
             a.generation == generation
                 && a.held.as_deref() == held_ref.map(|h| h.0)
-                && a.corners.len() == corners.len()
-                && a.corners
-                    .iter()
-                    .zip(&corners)
-                    .all(|(p, n)| (n - p).norm() + ridden < a.free)
+                && a.base == base
+                && moved + ridden < a.free
         });
         let mut touching = false;
         if !within {
@@ -105,9 +114,13 @@ impl<'a> WallRun<'a> {
                 return;
             }
             touching = clear.any <= TOUCH;
+            let free = clear.any.min(clear.loose - LOOSE_MARGIN);
+            let corners = self.phys.robot_corners(&at, held_ref);
             self.events.anchor = Some(Anchor {
-                corners,
-                free: clear.any.min(clear.loose - LOOSE_MARGIN),
+                levers: self.phys.robot_levers(&at, &corners, free),
+                q: at.clone(),
+                base,
+                free,
                 generation,
                 held: held_ref.map(|h| h.0.to_string()),
                 t: self.t,
