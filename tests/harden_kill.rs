@@ -210,3 +210,46 @@ fn killed_runs_leave_no_partial_file() {
     }
     assert_eq!(kills, 20);
 }
+
+#[test]
+fn a_report_run_removes_the_staging_folders_that_killed_runs_left() {
+    let scratch = tempfile::tempdir().unwrap();
+    let report = scratch.path().join("run");
+    // Process ids beyond Linux's largest (2^22): no such process can be running.
+    let dead = scratch.path().join(".run.4194399.tmp");
+    let dead_old = scratch.path().join(".run.4194398.old");
+    // A live process's folder (this test's own) and another report's stay.
+    let live = scratch
+        .path()
+        .join(format!(".run.{}.tmp", std::process::id()));
+    let other = scratch.path().join(".other.4194399.tmp");
+    for d in [&dead, &dead_old, &live, &other] {
+        std::fs::create_dir_all(d).unwrap();
+        std::fs::write(d.join("index.html"), "half").unwrap();
+    }
+    let status = bin()
+        .args([
+            "simulate",
+            model("tm1.ifc").to_str().unwrap(),
+            "--no-cache",
+            "--report",
+        ])
+        .arg(&report)
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert!(report.join("index.html").exists());
+    if !Path::new("/proc/self").exists() {
+        eprintln!("skipped: this system does not list its processes in /proc");
+        return;
+    }
+    assert!(
+        !dead.exists() && !dead_old.exists(),
+        "dead runs' staging folders remain"
+    );
+    assert!(
+        live.exists() && other.exists(),
+        "a live run's or another report's folder was removed"
+    );
+}

@@ -338,6 +338,37 @@ fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
     Err(std::io::Error::from(std::io::ErrorKind::Unsupported))
 }
 
+/// Removes the staging folders (`.NAME.PID.tmp`, `.NAME.PID.old`) that runs killed while
+/// writing this report left beside it: those of processes no longer running. Only where the
+/// system lists its processes (`/proc`); a folder whose process may still run is kept.
+fn remove_dead_staging(parent: &Path, name: &str) {
+    let processes = Path::new("/proc");
+    if !processes.join("self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    let prefix = format!(".{name}.");
+    for entry in entries.flatten() {
+        let file_name = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = file_name.strip_prefix(&prefix) else {
+            continue;
+        };
+        let Some(pid) = rest
+            .strip_suffix(".tmp")
+            .or_else(|| rest.strip_suffix(".old"))
+            .and_then(|pid| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        let dead = pid != std::process::id() && !processes.join(pid.to_string()).exists();
+        if dead && entry.file_type().is_ok_and(|t| t.is_dir()) {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
 /// Writes the report's files into `dir`: built in a fresh temporary folder beside it, then
 /// swapped into place (an existing `dir` is replaced only once the new one is complete).
 pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
@@ -351,6 +382,7 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
         .ok_or_else(|| std::io::Error::other("the report path names no folder"))?
         .to_string_lossy()
         .into_owned();
+    remove_dead_staging(&parent, &name);
     let tmp = parent.join(format!(".{name}.{}.tmp", std::process::id()));
     let old = parent.join(format!(".{name}.{}.old", std::process::id()));
     let _ = std::fs::remove_dir_all(&tmp);
