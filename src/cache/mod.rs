@@ -3,11 +3,14 @@
 //! share between processes and machines, and clear.
 
 pub mod key;
+pub mod plan;
 pub mod record_codec;
 pub mod sim;
 pub mod store;
 pub mod trace_codec;
+pub mod value_codec;
 
+pub use plan::reason_plan_cached;
 pub use sim::{
     CacheCounts, Need, Shard, ShardRun, cached_simulation, simulate_cached, simulate_cached_for,
     simulate_shard,

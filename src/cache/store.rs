@@ -14,6 +14,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Subfolder of wall simulation entries.
 const WALLS: &str = "walls";
+/// Subfolder of `plan`'s part entries.
+const PLANS: &str = "plans";
 /// Entries of `why`'s single-wall cache, kept at the top of the folder.
 const WHY_PREFIX: &str = "sim-";
 
@@ -51,6 +53,23 @@ impl Cache {
             .join(WALLS)
             .join(&key[..2.min(key.len())])
             .join(format!("{key}.json"))
+    }
+
+    fn plan_path(&self, key: &str) -> PathBuf {
+        self.dir
+            .join(PLANS)
+            .join(&key[..2.min(key.len())])
+            .join(format!("{key}.part"))
+    }
+
+    /// The bytes of a plan part's entry (the caller verifies them), None when absent.
+    pub fn get_plan(&self, key: &str) -> Option<Vec<u8>> {
+        std::fs::read(self.plan_path(key)).ok()
+    }
+
+    /// Stores a plan part's entry, like `put_wall`.
+    pub fn put_plan(&self, key: &str, bytes: &[u8]) {
+        self.put(&self.plan_path(key), |w| w.write_all(bytes));
     }
 
     /// A wall's pose trace sits beside its record, under the same key.
@@ -134,6 +153,8 @@ pub struct CacheInfo {
     pub traces: u64,
     /// Walls simulated for `why`.
     pub why_walls: u64,
+    /// Reasoned parts of models for `plan` (a part: the walls that touch one another).
+    pub plan_parts: u64,
     pub bytes: u64,
 }
 
@@ -150,6 +171,7 @@ pub fn info(dir: &Path) -> std::io::Result<CacheInfo> {
             Kind::Wall => info.walls += 1,
             Kind::Trace => info.traces += 1,
             Kind::Why => info.why_walls += 1,
+            Kind::Plan => info.plan_parts += 1,
         }
     }
     Ok(info)
@@ -166,11 +188,13 @@ pub fn clear(dir: &Path) -> std::io::Result<u64> {
         }
     }
     // Now-empty fan-out folders go too; a folder something else put files in stays.
-    if let Ok(subdirs) = std::fs::read_dir(dir.join(WALLS)) {
-        for sub in subdirs.flatten() {
-            let _ = std::fs::remove_dir(sub.path());
+    for folder in [WALLS, PLANS] {
+        if let Ok(subdirs) = std::fs::read_dir(dir.join(folder)) {
+            for sub in subdirs.flatten() {
+                let _ = std::fs::remove_dir(sub.path());
+            }
+            let _ = std::fs::remove_dir(dir.join(folder));
         }
-        let _ = std::fs::remove_dir(dir.join(WALLS));
     }
     Ok(removed)
 }
@@ -179,6 +203,7 @@ enum Kind {
     Wall,
     Trace,
     Why,
+    Plan,
 }
 
 struct EntryFile {
@@ -226,6 +251,22 @@ fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
                     path: e.path(),
                     kind,
                 });
+            }
+        }
+    }
+    if let Ok(subdirs) = std::fs::read_dir(dir.join(PLANS)) {
+        for sub in subdirs.flatten() {
+            let Ok(entries) = std::fs::read_dir(sub.path()) else {
+                continue;
+            };
+            for e in entries.flatten() {
+                let name = e.file_name().to_string_lossy().into_owned();
+                if name.ends_with(".part") || (name.starts_with('.') && name.ends_with(".tmp")) {
+                    files.push(EntryFile {
+                        path: e.path(),
+                        kind: Kind::Plan,
+                    });
+                }
             }
         }
     }

@@ -85,11 +85,12 @@ pub fn run(cmd: CacheCommand) -> CmdResult {
             } else {
                 print_stdout(&format!(
                     "{}\n{} simulated walls ({} with the motion for reports), {} walls simulated \
-                     for `why`, {:.1} MB\n",
+                     for `why`, {} reasoned model parts for `plan`, {:.1} MB\n",
                     info.dir.display(),
                     info.walls,
                     info.traces,
                     info.why_walls,
+                    info.plan_parts,
                     info.bytes as f64 / 1e6
                 ))
             }

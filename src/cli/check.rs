@@ -69,6 +69,16 @@ pub fn load_inputs(
     model: &Path,
     inputs: &ReasoningInputs,
 ) -> Result<(Model, Cell, Facts), Failure> {
+    let (model, cell, mut facts) = load_model_facts(model, inputs)?;
+    add_placement_facts(&mut facts, &cell, &rule_base(&inputs.rules_dir))?;
+    Ok((model, cell, facts))
+}
+
+/// The model, the cell and their facts, before the placement search.
+pub fn load_model_facts(
+    model: &Path,
+    inputs: &ReasoningInputs,
+) -> Result<(Model, Cell, Facts), Failure> {
     let contact_tolerance_mm = inputs.contact_tolerance;
     if !(contact_tolerance_mm.is_finite() && (0.0..=100.0).contains(&contact_tolerance_mm)) {
         return Err(Failure::bad_input(format!(
@@ -83,7 +93,6 @@ pub fn load_inputs(
     };
     let mut facts = model_facts(&model, &contacts);
     facts.extend(cell_facts(&cell));
-    add_placement_facts(&mut facts, &cell, &rule_base(&inputs.rules_dir))?;
     Ok((model, cell, facts))
 }
 

@@ -1,10 +1,14 @@
-//! `framewright plan MODEL.ifc [--cell C] [--json]`: walls, roles, assembly
-//! order, nailing and framing targets.
+//! `framewright plan MODEL.ifc [--cell C] [--json] [--cache DIR | --no-cache]`: walls, roles,
+//! assembly order, nailing and framing targets. The built-in rules' results are cached per
+//! independent part of the model, so a plan after a small edit reasons only what changed.
 
-use super::check::{ReasoningInputs, load_inputs, rule_base};
+use super::cache::{CacheArgs, warn_if_unwritable};
+use super::check::{ReasoningInputs, load_model_facts, rule_base};
 use super::{CmdResult, print_stdout, write_stdout};
+use framewright::cache::reason_plan_cached;
+use framewright::frame::placement::add_placement_facts;
 use framewright::frame::plan::Plan;
-use framewright::frame::reason_selected;
+use framewright::frame::{RuleLimits, reason_selected};
 use framewright::report::plan::PlanReport;
 use std::path::PathBuf;
 
@@ -17,13 +21,34 @@ pub struct PlanArgs {
     /// Print JSON instead of one line per wall.
     #[arg(long)]
     pub json: bool,
+    /// The cache holds the built-in rules' results per part of the model (not used with
+    /// --rules-dir).
+    #[command(flatten)]
+    pub cache: CacheArgs,
 }
 
 pub fn run(args: PlanArgs) -> CmdResult {
     let inputs = &args.inputs;
-    let (model, _, facts) = load_inputs(&args.model, inputs)?;
-    let reasoned = reason_selected(&facts, &rule_base(&inputs.rules_dir), Plan::RELATIONS)?;
-    let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
+    let (model, cell, mut facts) = load_model_facts(&args.model, inputs)?;
+    let cache = match inputs.rules_dir {
+        None => args.cache.open(),
+        Some(_) => None,
+    };
+    let (reasoned, counts) = match &cache {
+        Some(cache) => {
+            let (reasoned, counts) =
+                reason_plan_cached(&facts, &cell, cache, &RuleLimits::from_env()?)?;
+            (reasoned, Some(counts))
+        }
+        None => {
+            let engine = rule_base(&inputs.rules_dir);
+            add_placement_facts(&mut facts, &cell, &engine)?;
+            (reason_selected(&facts, &engine, Plan::RELATIONS)?, None)
+        }
+    };
+    warn_if_unwritable(cache.as_ref());
+    let mut report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
+    report.cache = counts;
     if args.json {
         write_stdout(|out| report.write_json(&mut &mut *out))
     } else {

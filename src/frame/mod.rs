@@ -5,6 +5,7 @@
 pub mod cell_facts;
 pub mod facts;
 pub mod limits;
+pub mod partition;
 pub mod placement;
 pub mod plan;
 
@@ -161,7 +162,7 @@ fn reason_unchecked(
 }
 
 /// Relations up to this size are sorted and deduplicated after merging parts.
-const SMALL_RELATION: usize = 4096;
+pub(crate) const SMALL_RELATION: usize = 4096;
 
 /// The compiled rule base, run on each container's facts in parallel and the
 /// results merged (same relations as one run over everything). With `selected`, only those

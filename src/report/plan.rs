@@ -15,6 +15,9 @@ pub struct PlanReport {
     pub members: Vec<MemberRow>,
     pub walls: Vec<WallRow>,
     pub warnings: Vec<String>,
+    /// Walls reasoned and walls read from the cache (absent without a cache).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cache: Option<crate::cache::CacheCounts>,
 }
 
 #[derive(Debug, Serialize)]
@@ -214,6 +217,7 @@ impl PlanReport {
             members,
             walls,
             warnings,
+            cache: None,
         }
     }
 

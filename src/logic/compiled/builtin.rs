@@ -69,7 +69,8 @@ inputs! {
     "placement_nail_reaches" => r_placement_nail_reaches(0: Sym, 1: Sym, 2: F64, 3: F64, 4: F64, 5: F64, 6: F64);
 }
 
-// What `plan` (frame::plan::Plan::RELATIONS) and the placement search read.
+// What `plan` (frame::plan::Plan::RELATIONS), the placement search and the plan cache's
+// storey check (`storey_reach`) read.
 outputs! {
     "wall" => r_wall(0);
     "wall_of" => r_wall_of(0, 1);
@@ -87,6 +88,7 @@ outputs! {
     "lumber" => r_lumber(0);
     "across" => r_across(0, 1);
     "coplanar" => r_coplanar(0, 1);
+    "storey_reach" => r_storey_reach(0, 1, 2, 3);
     "placement_target_at_zero" => r_placement_target_at_zero(0, 1);
     "placement_nail_at_zero" => r_placement_nail_at_zero(0, 1, 2, 3, 4, 5, 6);
 }

@@ -1,0 +1,655 @@
+//! `plan` through the cache: the model's facts split into independent parts
+//! (`frame::partition`), each part's reasoning (placement search and the rule base, the
+//! relations `plan` reads) stored under a hash of exactly the facts it read, the cell and the
+//! build. A part's walls also depend on how far the rest of their storey reaches along their
+//! across direction (`storey_reach`, which decides the outer face of an exterior wall): an
+//! entry keeps the rows it was computed with, and is used only while the storey's lumber
+//! still reaches exactly that far. An edit to one wall recomputes that wall's part (and the
+//! parts whose storey extent it moved), nothing else.
+
+use super::key::build_id;
+use super::value_codec::{Reader, put_relations, put_str};
+use super::{Cache, CacheCounts};
+use crate::cell::{Cell, OffsetX};
+use crate::frame::partition::{Part, Partition};
+use crate::frame::placement::{SearchOptions, placement_facts_with};
+use crate::frame::plan::Plan;
+use crate::frame::{Facts, FrameError, Reasoned, RuleLimits};
+use crate::logic::compiled::{Relations, builtin};
+use crate::logic::functors::defs::{box_centre, box_radius, dot};
+use crate::logic::value::{F64, OBox, Value, Vec3};
+use rayon::prelude::*;
+use rustc_hash::{FxHashMap, FxHashSet};
+use std::sync::Mutex;
+
+/// What the placement search reads of the first pass (as `frame::placement` runs it).
+const FIRST_PASS: &[&str] = &[
+    "piece_size",
+    "wall_of",
+    "placement_target_at_zero",
+    "placement_nail_at_zero",
+];
+/// The relation an entry's context check reads.
+const REACH: &str = "storey_reach";
+/// Start of every entry: the format.
+const MAGIC: &[u8] = b"framewright plan part 1\n";
+/// Above this share of missed parts a container is reasoned whole (one run, split into
+/// entries afterwards) instead of part by part (each part with its storey as context).
+const WHOLE_CONTAINER_SHARE: f64 = 0.25;
+
+/// `plan`'s reasoning through the cache: the same relations `reason_selected(facts,
+/// Compiled, Plan::RELATIONS)` gives after `add_placement_facts`, in the same order, and
+/// how many walls were reasoned and how many came from the cache. `facts` are the model's
+/// and the cell's, without placement facts (the search runs per part here).
+pub fn reason_plan_cached(
+    facts: &Facts,
+    cell: &Cell,
+    cache: &Cache,
+    limits: &RuleLimits,
+) -> Result<(Reasoned, CacheCounts), FrameError> {
+    let partition = Partition::of(facts);
+    let base = base_key(cell);
+    let keys: Vec<String> = partition
+        .parts
+        .par_iter()
+        .map(|p| part_key(&base, p))
+        .collect();
+    let extents = Extents::of(facts, &partition);
+    let mut counts = CacheCounts::default();
+    // Each part's relations (with its storey_reach rows), from the cache or computed.
+    let looked: Vec<Found> = keys
+        .par_iter()
+        .zip(&partition.parts)
+        .map(
+            |(key, part)| match cache.get_plan(key).map(|b| decode(key, &b)) {
+                Some(Some(r)) if extents.agree(part.container, &r) => Found::Hit(r),
+                Some(Some(_)) | None => Found::Miss,
+                Some(None) => Found::Rejected,
+            },
+        )
+        .collect();
+    let rejected: Vec<bool> = looked
+        .iter()
+        .map(|f| matches!(f, Found::Rejected))
+        .collect();
+    let mut results: Vec<Option<Relations>> = looked
+        .into_iter()
+        .map(|f| match f {
+            Found::Hit(r) => Some(r),
+            Found::Miss | Found::Rejected => None,
+        })
+        .collect();
+    counts.cached = results
+        .iter()
+        .flatten()
+        .map(|r| r.get("wall").map_or(0, Vec::len))
+        .sum();
+
+    // What to compute: whole containers where many parts missed, single parts elsewhere.
+    let mut jobs: Vec<Job> = Vec::new();
+    for (c, container) in partition.containers.iter().enumerate() {
+        let parts: Vec<usize> = (0..partition.parts.len())
+            .filter(|&i| partition.parts[i].container == c)
+            .collect();
+        let missed: Vec<usize> = parts
+            .iter()
+            .copied()
+            .filter(|&i| results[i].is_none())
+            .collect();
+        if missed.is_empty() {
+            continue;
+        }
+        if missed.len() as f64 > WHOLE_CONTAINER_SHARE * parts.len() as f64 {
+            jobs.push(Job::Container {
+                parts,
+                size: container.pieces.len(),
+            });
+        } else {
+            jobs.extend(missed.into_iter().map(Job::Part));
+        }
+    }
+    jobs.sort_by_key(|j| std::cmp::Reverse(j.size(&partition)));
+    let total = std::sync::atomic::AtomicU64::new(0);
+    let computed: Mutex<Vec<(usize, Relations)>> = Mutex::new(Vec::new());
+    jobs.par_iter()
+        .try_for_each(|job| -> Result<(), FrameError> {
+            let (done, tuples) = job.run(facts, &partition, cell)?;
+            let sum = total.fetch_add(tuples, std::sync::atomic::Ordering::Relaxed) + tuples;
+            limits.check_tuples(sum)?;
+            for (i, relations) in &done {
+                cache.put_plan(&keys[*i], &encode(&keys[*i], relations));
+            }
+            computed.lock().map_err(|_| poisoned())?.extend(done);
+            Ok(())
+        })?;
+    for (i, relations) in computed.into_inner().map_err(|_| poisoned())? {
+        if results[i].is_none() {
+            let walls = relations.get("wall").map_or(0, Vec::len);
+            counts.computed += walls;
+            if rejected[i] {
+                counts.rejected += walls;
+            }
+            results[i] = Some(relations);
+        }
+    }
+
+    let relations = merge(&partition, results);
+    limits.check_walls(relations.get("wall").map_or(0, Vec::len) as u64)?;
+    Ok((
+        Reasoned {
+            relations,
+            engine: None,
+        },
+        counts,
+    ))
+}
+
+/// What the cache held for a part: a usable entry, none (or one whose storey has changed),
+/// or one found torn, altered or foreign.
+enum Found {
+    Hit(Relations),
+    Miss,
+    Rejected,
+}
+
+fn poisoned() -> FrameError {
+    FrameError::Compiled("a reasoning thread failed".into())
+}
+
+/// A unit of reasoning.
+enum Job {
+    /// Every part of a container in one run.
+    Container { parts: Vec<usize>, size: usize },
+    /// One part, its storey as context.
+    Part(usize),
+}
+
+impl Job {
+    fn size(&self, partition: &Partition) -> usize {
+        match self {
+            Job::Container { size, .. } => *size,
+            Job::Part(i) => partition.parts[*i].pieces.len(),
+        }
+    }
+
+    /// The job's parts' relations and the tuples its runs derived.
+    fn run(
+        &self,
+        facts: &Facts,
+        partition: &Partition,
+        cell: &Cell,
+    ) -> Result<(Vec<(usize, Relations)>, u64), FrameError> {
+        match self {
+            Job::Container { parts, .. } => {
+                // The parts' facts, with the file's piece indices: the parts' own start at 0
+                // each, and the rules take a wall's name from the piece of its least index.
+                let mut input = Relations::new();
+                let mut pieces: FxHashSet<&str> = FxHashSet::default();
+                for &i in parts {
+                    let part = &partition.parts[i];
+                    pieces.extend(part.pieces.iter().map(String::as_str));
+                    for (name, tuples) in &part.relations {
+                        if name != "piece_index" {
+                            input
+                                .entry(name.clone())
+                                .or_default()
+                                .extend(tuples.iter().cloned());
+                        }
+                    }
+                }
+                // Every part holds the cell's facts: once is enough (the program's input
+                // tables keep duplicates, and its joins would repeat them).
+                for tuples in input.values_mut() {
+                    tuples.sort();
+                    tuples.dedup();
+                }
+                let indices = facts.tuples.get("piece_index").into_iter().flatten();
+                input.insert(
+                    "piece_index".into(),
+                    indices
+                        .filter(|(t, _)| {
+                            t.first()
+                                .and_then(Value::as_symbol)
+                                .is_some_and(|p| pieces.contains(p))
+                        })
+                        .map(|(t, _)| t.clone())
+                        .collect(),
+                );
+                let (out, tuples) = reason_part(input, cell)?;
+                Ok((split(partition, parts, out), tuples))
+            }
+            Job::Part(i) => {
+                let mut input = partition.parts[*i].relations.clone();
+                let context = partition.context(facts, *i);
+                let others: FxHashSet<&str> = context
+                    .get("piece_container")
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|t| t.first()?.as_symbol())
+                    .collect();
+                for (name, tuples) in &context {
+                    input
+                        .entry(name.clone())
+                        .or_default()
+                        .extend(tuples.iter().cloned());
+                }
+                let (mut out, tuples) = reason_part(input, cell)?;
+                // What was derived about the context pieces is theirs, not this part's.
+                for rows in out.values_mut() {
+                    rows.retain(|t| {
+                        !t.iter()
+                            .any(|v| v.as_symbol().is_some_and(|s| others.contains(s)))
+                    });
+                }
+                Ok((vec![(*i, out)], tuples))
+            }
+        }
+    }
+}
+
+/// The placement search (when the cell places walls itself) and the rule base on one
+/// part's or container's facts: `plan`'s relations and the storey's reach rows.
+fn reason_part(mut input: Relations, cell: &Cell) -> Result<(Relations, u64), FrameError> {
+    let mut tuples = 0;
+    if let OffsetX::Auto { min, max } = cell.assembly.offset_x {
+        let first = builtin::run_selected(&input, FIRST_PASS).map_err(FrameError::Compiled)?;
+        tuples += first.tuples;
+        let first = Reasoned {
+            relations: first.relations,
+            engine: None,
+        };
+        let found = placement_facts_with(cell, &first, min, max, &SearchOptions::default());
+        for (name, rows) in found.relations() {
+            input.entry(name).or_default().extend(rows);
+        }
+    }
+    let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
+    wanted.push(REACH);
+    let second = builtin::run_selected(&input, &wanted).map_err(FrameError::Compiled)?;
+    Ok((second.relations, tuples + second.tuples))
+}
+
+/// A container's relations split by part: a tuple goes to the part of the first piece or
+/// group it names; a tuple naming none (the storey's reach, what the cell alone gives) to
+/// every part.
+fn split(partition: &Partition, parts: &[usize], out: Relations) -> Vec<(usize, Relations)> {
+    let mut owner: FxHashMap<&str, usize> = FxHashMap::default();
+    for (k, &i) in parts.iter().enumerate() {
+        let part = &partition.parts[i];
+        for id in part.pieces.iter().chain(&part.groups) {
+            owner.insert(id.as_str(), k);
+        }
+    }
+    let mut split: Vec<Relations> = vec![Relations::new(); parts.len()];
+    for (name, rows) in out {
+        for r in split.iter_mut() {
+            r.insert(name.clone(), Vec::new());
+        }
+        for t in rows {
+            let of = t
+                .iter()
+                .find_map(|v| v.as_symbol().and_then(|s| owner.get(s)).copied());
+            match of {
+                Some(k) => split[k].get_mut(&name).expect("inserted").push(t),
+                None => split.iter_mut().for_each(|r| {
+                    r.get_mut(&name).expect("inserted").push(t.clone());
+                }),
+            }
+        }
+    }
+    parts.iter().copied().zip(split).collect()
+}
+
+/// The parts' relations as the container-by-container run returns them: containers
+/// largest first, each container's tuples sorted, small relations sorted whole; without
+/// the reach rows.
+fn merge(partition: &Partition, results: Vec<Option<Relations>>) -> Relations {
+    let mut by_container: Vec<Relations> = vec![Relations::new(); partition.containers.len()];
+    for (part, r) in partition.parts.iter().zip(results) {
+        for (name, rows) in r.into_iter().flatten() {
+            if name != REACH {
+                by_container[part.container]
+                    .entry(name)
+                    .or_default()
+                    .extend(rows);
+            }
+        }
+    }
+    let mut order: Vec<usize> = (0..partition.containers.len()).collect();
+    order.sort_by_key(|&c| std::cmp::Reverse(partition.containers[c].pieces.len()));
+    let mut merged = Relations::new();
+    for c in order {
+        for (name, mut rows) in std::mem::take(&mut by_container[c]) {
+            rows.sort();
+            rows.dedup();
+            merged.entry(name).or_default().extend(rows);
+        }
+    }
+    for rows in merged.values_mut() {
+        if rows.len() <= crate::frame::SMALL_RELATION {
+            rows.sort();
+            rows.dedup();
+        }
+    }
+    merged
+}
+
+/// What every part's key shares: the format, the build, the cell (its facts and what the
+/// placement search reads: robot, tool, offsets) and the search options.
+fn base_key(cell: &Cell) -> blake3::Hasher {
+    let mut h = blake3::Hasher::new();
+    h.update(b"framewright plan part\0");
+    h.update(build_id().as_bytes());
+    h.update(format!("\0{cell:?}\0{:?}\0", SearchOptions::default()).as_bytes());
+    h
+}
+
+/// A part's key: the base and its facts, byte for byte.
+fn part_key(base: &blake3::Hasher, part: &Part) -> String {
+    let mut h = base.clone();
+    let mut bytes = Vec::new();
+    put_relations(&mut bytes, &part.relations);
+    h.update(&bytes);
+    h.finalize().to_hex().to_string()
+}
+
+fn encode(key: &str, relations: &Relations) -> Vec<u8> {
+    let mut out = MAGIC.to_vec();
+    put_str(&mut out, key);
+    put_relations(&mut out, relations);
+    let digest = blake3::hash(&out);
+    out.extend_from_slice(digest.as_bytes());
+    out
+}
+
+/// An entry's relations, or None when it is torn, altered, of another format or key.
+fn decode(key: &str, bytes: &[u8]) -> Option<Relations> {
+    let body = bytes.get(..bytes.len().checked_sub(32)?)?;
+    let digest = bytes.get(body.len()..)?;
+    if blake3::hash(body).as_bytes() != digest {
+        return None;
+    }
+    let mut r = Reader::new(body.strip_prefix(MAGIC)?);
+    if r.str()? != key {
+        return None;
+    }
+    let relations = r.relations()?;
+    r.is_empty().then_some(relations)
+}
+
+/// Least and greatest projection of a container's lumber on a direction.
+type Reach = (F64, F64);
+/// A container and a direction's bits.
+type DirectionKey = (usize, [u64; 3]);
+
+/// How far each container's lumber reaches along a direction, computed as the rule
+/// `storey_reach` (rules/frame.dl) computes it: over the pieces the rule `lumber_section`
+/// (rules/walls.dl) takes as lumber, the box centre's projection minus / plus its projected
+/// radius, the least / greatest in the floats' total order. Tested against the rules.
+struct Extents {
+    /// Per container, its lumber boxes.
+    lumber: Vec<Vec<OBox>>,
+    /// Container name → index.
+    index: FxHashMap<String, usize>,
+    memo: Mutex<FxHashMap<DirectionKey, Option<Reach>>>,
+}
+
+impl Extents {
+    fn of(facts: &Facts, partition: &Partition) -> Extents {
+        let boxes: FxHashMap<&str, &OBox> = facts
+            .tuples
+            .get("piece_box")
+            .into_iter()
+            .flatten()
+            .filter_map(|(t, _)| match (t.first()?.as_symbol()?, t.get(1)?) {
+                (p, Value::Box(b)) => Some((p, &**b)),
+                _ => None,
+            })
+            .collect();
+        let lumber: FxHashSet<&str> = facts
+            .tuples
+            .get("piece_size")
+            .into_iter()
+            .flatten()
+            .filter_map(|(t, _)| {
+                let (w, th) = (t.get(2)?.as_float()?, t.get(3)?.as_float()?);
+                (is_lumber_section(w, th)).then_some(t.first()?.as_symbol()?)
+            })
+            .collect();
+        Extents {
+            lumber: partition
+                .containers
+                .iter()
+                .map(|c| {
+                    c.pieces
+                        .iter()
+                        .map(|&i| partition.pieces[i].as_str())
+                        .filter(|p| lumber.contains(p))
+                        .filter_map(|p| boxes.get(p).map(|b| **b))
+                        .collect()
+                })
+                .collect(),
+            index: partition
+                .containers
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (c.name.clone(), i))
+                .collect(),
+            memo: Mutex::new(FxHashMap::default()),
+        }
+    }
+
+    /// The container's reach along `k`: (least, greatest), None without lumber.
+    fn along(&self, container: usize, k: Vec3) -> Option<Reach> {
+        let memo_key = (
+            container,
+            [k.0.x.to_bits(), k.0.y.to_bits(), k.0.z.to_bits()],
+        );
+        if let Some(v) = self.memo.lock().ok()?.get(&memo_key) {
+            return *v;
+        }
+        let projections = self.lumber[container].iter().map(|b| {
+            let c = dot(box_centre(*b), k).0;
+            let r = box_radius(*b, k).0;
+            (F64(c - r), F64(c + r))
+        });
+        let v = projections.fold(None, |acc: Option<Reach>, (lo, hi)| {
+            Some(acc.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))))
+        });
+        self.memo.lock().ok()?.insert(memo_key, v);
+        v
+    }
+
+    /// Whether every reach row an entry was computed with still holds for its container.
+    fn agree(&self, container: usize, entry: &Relations) -> bool {
+        entry.get(REACH).into_iter().flatten().all(|row| {
+            let (Some(c), Some(Value::Vec3(k)), Some(Value::Float(lo)), Some(Value::Float(hi))) = (
+                row.first().and_then(Value::as_symbol),
+                row.get(1),
+                row.get(2),
+                row.get(3),
+            ) else {
+                return false;
+            };
+            self.index.get(c) == Some(&container) && self.along(container, *k) == Some((*lo, *hi))
+        })
+    }
+}
+
+/// `lumber_section` of rules/walls.dl: at most 0.2 m thick (and at least 1 cm) and 0.45 m wide.
+fn is_lumber_section(width: f64, thickness: f64) -> bool {
+    (0.01..=0.2).contains(&thickness) && width <= 0.45
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{cell_facts, model_facts, reason_selected};
+    use crate::geom::ContactOptions;
+    use crate::ifc::Model;
+
+    /// The mirrored storey extent equals the rules' `storey_reach`, bit for bit, on models
+    /// with exterior and interior walls, several storeys and openings.
+    #[test]
+    fn the_storey_extent_check_computes_what_the_rule_derives() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let cell = Cell::load("study-abb").unwrap();
+        let mut checked = 0;
+        for model in [
+            Model::open(dir.join("examples/models/tm3.ifc")).unwrap(),
+            small_block(),
+        ] {
+            let mut facts = model_facts(&model, &ContactOptions::default());
+            facts.extend(cell_facts(&cell));
+            let partition = Partition::of(&facts);
+            let extents = Extents::of(&facts, &partition);
+            let reasoned =
+                reason_selected(&facts, &crate::frame::RuleEngine::Compiled, &[REACH]).unwrap();
+            for row in reasoned.get(REACH) {
+                let c = extents.index[row[0].as_symbol().unwrap()];
+                let Value::Vec3(k) = &row[1] else { panic!() };
+                let want = (row[2].as_float().unwrap(), row[3].as_float().unwrap());
+                let got = extents.along(c, *k).unwrap();
+                assert_eq!(
+                    (got.0.0.to_bits(), got.1.0.to_bits()),
+                    (want.0.to_bits(), want.1.to_bits())
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked >= 6, "only {checked} storey_reach rows checked");
+    }
+
+    /// Two storeys of two units with openings, members grouped in IfcWall.
+    fn small_block() -> Model {
+        use crate::synth::building::{BlockSpec, blocks};
+        use crate::synth::{Grouping, WriteOptions, models, write_ifc};
+        let spec = BlockSpec {
+            unit: models::default_building_spec(),
+            blocks: 1,
+            storeys: 2,
+            rows: 1,
+            cols: 2,
+            gap: 3.0,
+            floor_depth: 0.3,
+        };
+        let layout = blocks(&spec, "small").unwrap();
+        let written = write_ifc(
+            &layout,
+            &WriteOptions {
+                grouping: Grouping::Wall,
+                openings: true,
+                file_name: "small.ifc".into(),
+                ..WriteOptions::default()
+            },
+        )
+        .unwrap();
+        Model::from_bytes("small.ifc", written.ifc.into_bytes(), &Default::default()).unwrap()
+    }
+
+    fn facts_of(model: &Model, cell: &Cell) -> Facts {
+        let mut facts = model_facts(model, &ContactOptions::default());
+        facts.extend(cell_facts(cell));
+        facts
+    }
+
+    /// What `plan` reasons without the cache.
+    fn uncached(facts: &Facts, cell: &Cell) -> Relations {
+        let mut facts = facts.clone();
+        let engine = crate::frame::RuleEngine::Compiled;
+        crate::frame::placement::add_placement_facts(&mut facts, cell, &engine).unwrap();
+        reason_selected(&facts, &engine, Plan::RELATIONS)
+            .unwrap()
+            .relations
+    }
+
+    /// Every wall lies in one part, and so does every coplanar pair the rules find.
+    #[test]
+    fn parts_hold_whole_walls() {
+        let cell = Cell::load("study-abb").unwrap();
+        let facts = facts_of(&small_block(), &cell);
+        let partition = Partition::of(&facts);
+        let part_of: FxHashMap<&str, usize> = partition
+            .parts
+            .iter()
+            .enumerate()
+            .flat_map(|(k, p)| p.pieces.iter().map(move |id| (id.as_str(), k)))
+            .collect();
+        let r = uncached(&facts, &cell);
+        let mut walls: FxHashMap<&str, usize> = FxHashMap::default();
+        for t in &r["wall_of"] {
+            let (p, w) = (t[0].as_symbol().unwrap(), t[1].as_symbol().unwrap());
+            assert_eq!(
+                *walls.entry(w).or_insert(part_of[p]),
+                part_of[p],
+                "wall {w}"
+            );
+        }
+        for t in &r["coplanar"] {
+            let (a, b) = (t[0].as_symbol().unwrap(), t[1].as_symbol().unwrap());
+            assert_eq!(part_of[a], part_of[b]);
+        }
+        // The units' walls meet at corners, yet most walls are parts of their own.
+        assert!(walls.len() >= 16, "{} walls", walls.len());
+        assert!(
+            partition.parts.len() >= walls.len(),
+            "{} parts",
+            partition.parts.len()
+        );
+    }
+
+    /// Cold, warm and after an edit of one stud (recomputed alone, its storey as context),
+    /// the cached reasoning gives what the uncached one gives, tuple for tuple and in order.
+    #[test]
+    fn cached_reasoning_equals_the_uncached() {
+        let cell = Cell::load("study-abb").unwrap();
+        let mut facts = facts_of(&small_block(), &cell);
+        let dir = tempfile::tempdir().unwrap();
+        let cache = Cache::new(dir.path());
+        let limits = RuleLimits::default();
+        let want = uncached(&facts, &cell);
+        let (cold, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        assert_eq!(cold.relations, want);
+        let walls = want["wall"].len();
+        assert_eq!((counts.computed, counts.cached), (walls, 0));
+        let (warm, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        assert_eq!(warm.relations, want);
+        assert_eq!((counts.computed, counts.cached), (0, walls));
+
+        // Move one stud 20 mm along its wall (its box's thickness axis runs along the wall).
+        let role = &want["role"];
+        let stud = role
+            .iter()
+            .find(|t| t[1].as_symbol() == Some("stud"))
+            .and_then(|t| t[0].as_symbol())
+            .unwrap()
+            .to_string();
+        for (t, _) in facts.tuples.get_mut("piece_box").unwrap() {
+            if t[0].as_symbol() == Some(stud.as_str())
+                && let Value::Box(b) = &t[1]
+            {
+                let mut moved = **b;
+                moved.pose.translation.vector += moved.axis(2) * 0.02;
+                t[1] = Value::Box(std::sync::Arc::new(moved));
+            }
+        }
+        let want = uncached(&facts, &cell);
+        let (edited, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        assert_eq!(edited.relations, want);
+        assert_eq!(counts.computed, 1, "only the stud's wall is reasoned again");
+        assert_eq!(counts.cached, walls - 1);
+    }
+
+    #[test]
+    fn entries_come_back_and_torn_altered_or_foreign_ones_do_not() {
+        let mut r = Relations::new();
+        r.insert("wall".into(), vec![vec![Value::sym("w1")]]);
+        let bytes = encode("k1", &r);
+        assert_eq!(decode("k1", &bytes), Some(r));
+        assert_eq!(decode("k2", &bytes), None);
+        assert_eq!(decode("k1", &bytes[..bytes.len() - 1]), None);
+        let mut altered = bytes.clone();
+        altered[MAGIC.len() + 12] ^= 1;
+        assert_eq!(decode("k1", &altered), None);
+    }
+}

@@ -1,0 +1,363 @@
+//! Splits a model's facts into parts finer than its containers: the pieces of one container
+//! joined by a contact that can make them coplanar (one wall) or by an IFC group. The built-in
+//! rules relate two pieces of different walls only through such a contact (walls are
+//! connected coplanar contacts; roles, order and nailing read contacts within one wall) or a
+//! shared group (`group_split`), so a part's walls, roles, order and targets come from its own
+//! facts, with one exception: `storey_reach`, how far the whole container's lumber reaches
+//! along a wall's across direction (whether a wall is exterior). Contacts between pieces of
+//! two parts (a corner stud against the end of a crossing wall) are read by no rule and left
+//! out.
+//! A part run on its own therefore also gets the rest of its container as *context pieces*:
+//! their boxes, sizes and container only (no index, contact or group, so they form no wall),
+//! and everything derived about them is dropped afterwards.
+
+use super::Facts;
+use crate::logic::compiled::Relations;
+use crate::logic::{OBox, Value};
+use nalgebra::Vector3;
+use rustc_hash::FxHashMap;
+
+/// One independent part of a container.
+pub struct Part {
+    /// Index into `Partition::containers`.
+    pub container: usize,
+    /// Its pieces, in file order.
+    pub pieces: Vec<String>,
+    /// The IFC groups (IfcWall, IfcElementAssembly) its pieces belong to.
+    pub groups: Vec<String>,
+    /// Its facts: its pieces' tuples, their contacts, the facts about no piece (the cell);
+    /// `piece_index` renumbered from 0 in file order within the part (the rules only compare
+    /// indices of pieces of one wall, and no relation `plan` reads carries one), so that an
+    /// edit elsewhere in the file does not change the part.
+    pub relations: Relations,
+}
+
+/// A container (storey, building, or "" for none) and its pieces.
+pub struct Container {
+    pub name: String,
+    /// Indices into `Partition::pieces`.
+    pub pieces: Vec<usize>,
+}
+
+/// The parts of a model, in the order of their first piece in `piece_container`.
+pub struct Partition {
+    pub containers: Vec<Container>,
+    /// Every piece id, in `piece_container` order.
+    pub pieces: Vec<String>,
+    pub parts: Vec<Part>,
+}
+
+/// Relations that hold a piece's context facts: what `storey_reach` reads.
+pub const CONTEXT_RELATIONS: &[&str] = &["piece_box", "piece_size", "piece_container"];
+
+impl Partition {
+    /// Splits the facts. Contacts between pieces of two containers are dropped, as the
+    /// container split of `frame::reason` drops them.
+    pub fn of(facts: &Facts) -> Partition {
+        let mut containers: Vec<Container> = Vec::new();
+        let mut container_index: FxHashMap<&str, usize> = FxHashMap::default();
+        let mut pieces: Vec<String> = Vec::new();
+        let mut piece_index: FxHashMap<&str, usize> = FxHashMap::default();
+        let mut container_of: Vec<usize> = Vec::new();
+        for (t, _) in facts.tuples.get("piece_container").into_iter().flatten() {
+            let (Some(p), Some(c)) = (t[0].as_symbol(), t[1].as_symbol()) else {
+                continue;
+            };
+            if piece_index.contains_key(p) {
+                continue;
+            }
+            let next = containers.len();
+            let k = *container_index.entry(c).or_insert(next);
+            if k == next {
+                containers.push(Container {
+                    name: c.to_string(),
+                    pieces: Vec::new(),
+                });
+            }
+            piece_index.insert(p, pieces.len());
+            containers[k].pieces.push(pieces.len());
+            container_of.push(k);
+            pieces.push(p.to_string());
+        }
+
+        let mut sets = UnionFind::new(pieces.len());
+        let find = |v: Option<&Value>| {
+            v.and_then(Value::as_symbol)
+                .and_then(|p| piece_index.get(p).copied())
+        };
+        let mut across: Vec<Vec<Vector3<f64>>> = vec![Vec::new(); pieces.len()];
+        for (t, _) in facts.tuples.get("piece_box").into_iter().flatten() {
+            if let (Some(p), Some(Value::Box(b))) = (find(t.first()), t.get(1)) {
+                across[p] = across_candidates(b);
+            }
+        }
+        for (t, _) in facts.tuples.get("contact").into_iter().flatten() {
+            if let (Some(a), Some(b)) = (find(t.first()), find(t.get(1)))
+                && container_of[a] == container_of[b]
+                && may_be_coplanar(&across[a], &across[b])
+            {
+                sets.join(a, b);
+            }
+        }
+        let mut group_first: FxHashMap<(&str, usize), usize> = FxHashMap::default();
+        let mut groups_of: FxHashMap<usize, Vec<String>> = FxHashMap::default();
+        for (t, _) in facts.tuples.get("piece_group").into_iter().flatten() {
+            if let (Some(p), Some(g)) = (find(t.first()), t.get(1).and_then(Value::as_symbol)) {
+                let first = *group_first.entry((g, container_of[p])).or_insert(p);
+                sets.join(first, p);
+            }
+        }
+
+        // Parts numbered by their first piece.
+        let mut part_of_root: FxHashMap<usize, usize> = FxHashMap::default();
+        let mut part_of: Vec<usize> = Vec::with_capacity(pieces.len());
+        let mut parts: Vec<Part> = Vec::new();
+        for (i, piece) in pieces.iter().enumerate() {
+            let root = sets.find(i);
+            let next = parts.len();
+            let k = *part_of_root.entry(root).or_insert(next);
+            if k == next {
+                parts.push(Part {
+                    container: container_of[i],
+                    pieces: Vec::new(),
+                    groups: Vec::new(),
+                    relations: Relations::new(),
+                });
+            }
+            parts[k].pieces.push(piece.clone());
+            part_of.push(k);
+        }
+        for ((g, _), first) in &group_first {
+            groups_of
+                .entry(part_of[*first])
+                .or_default()
+                .push(g.to_string());
+        }
+        for (k, mut groups) in groups_of {
+            groups.sort();
+            parts[k].groups = groups;
+        }
+
+        for (name, tuples) in &facts.tuples {
+            let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); parts.len()];
+            for (tuple, _) in tuples {
+                match find(tuple.first()).map(|p| part_of[p]) {
+                    Some(k) if *name == "contact" => {
+                        if find(tuple.get(1)).map(|p| part_of[p]) == Some(k) {
+                            buckets[k].push(tuple.clone());
+                        }
+                    }
+                    Some(k) => buckets[k].push(tuple.clone()),
+                    None => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
+                }
+            }
+            for (part, mut bucket) in parts.iter_mut().zip(buckets) {
+                if *name == "piece_index" {
+                    renumber(&mut bucket);
+                }
+                bucket.sort();
+                bucket.dedup();
+                part.relations.insert(name.to_string(), bucket);
+            }
+        }
+        Partition {
+            containers,
+            pieces,
+            parts,
+        }
+    }
+
+    /// The context facts of `part`: the boxes, sizes and container of every other piece of its
+    /// container, read from `facts`.
+    pub fn context(&self, facts: &Facts, part: usize) -> Relations {
+        let own: rustc_hash::FxHashSet<&str> =
+            self.parts[part].pieces.iter().map(String::as_str).collect();
+        let container = &self.containers[self.parts[part].container];
+        let others: rustc_hash::FxHashSet<&str> = container
+            .pieces
+            .iter()
+            .map(|&i| self.pieces[i].as_str())
+            .filter(|p| !own.contains(p))
+            .collect();
+        CONTEXT_RELATIONS
+            .iter()
+            .map(|name| {
+                let tuples = facts
+                    .tuples
+                    .get(name)
+                    .into_iter()
+                    .flatten()
+                    .filter(|(t, _)| {
+                        t.first()
+                            .and_then(Value::as_symbol)
+                            .is_some_and(|p| others.contains(p))
+                    })
+                    .map(|(t, _)| t.clone())
+                    .collect();
+                (name.to_string(), tuples)
+            })
+            .collect()
+    }
+}
+
+/// Margin on the thresholds of the `across` and `coplanar` rules, so that rounding never
+/// makes this module call two pieces apart that the rules join.
+const MARGIN: f64 = 1e-6;
+
+/// Every direction the `across` rules (rules/walls.dl) can give a piece with this box, and
+/// maybe more: the width axis of an upright; the width axis of a piece lying flat, the
+/// thickness axis of one on edge. Lumber sizes are not checked (a piece that is not lumber
+/// has no across direction: more candidates only join more).
+fn across_candidates(b: &OBox) -> Vec<Vector3<f64>> {
+    let z = |k: usize| b.axis(k).z.abs();
+    let mut out = Vec::new();
+    if z(0) > 0.9 - MARGIN {
+        out.push(b.axis(1));
+    }
+    if z(0) < 0.1 + MARGIN {
+        if z(2) > 0.9 - MARGIN {
+            out.push(b.axis(1));
+        }
+        if z(1) > 0.9 - MARGIN {
+            out.push(b.axis(2));
+        }
+    }
+    out
+}
+
+/// Whether the rule `coplanar_contact` can hold for two touching pieces: their across
+/// directions parallel (the overlap condition is not checked).
+fn may_be_coplanar(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> bool {
+    a.iter()
+        .any(|da| b.iter().any(|db| da.dot(db).abs() > 0.99 - MARGIN))
+}
+
+/// `piece_index` tuples renumbered 0.. in the order of their indices.
+fn renumber(tuples: &mut [Vec<Value>]) {
+    let mut order: Vec<(i64, usize)> = tuples
+        .iter()
+        .enumerate()
+        .map(|(k, t)| (t.get(1).and_then(Value::as_number).unwrap_or(i64::MAX), k))
+        .collect();
+    order.sort();
+    for (rank, (_, k)) in order.into_iter().enumerate() {
+        tuples[k][1] = Value::Number(rank as i64);
+    }
+}
+
+/// Disjoint sets of piece indices.
+struct UnionFind {
+    parent: Vec<usize>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind {
+            parent: (0..n).collect(),
+        }
+    }
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.parent[i] != i {
+            self.parent[i] = self.parent[self.parent[i]];
+            i = self.parent[i];
+        }
+        i
+    }
+    fn join(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        // The smaller index stays the root: the parts do not depend on the join order.
+        if ra != rb {
+            let (lo, hi) = (ra.min(rb), ra.max(rb));
+            self.parent[hi] = lo;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::logic::Origin;
+
+    fn facts(rows: &[(&'static str, Vec<Value>)]) -> Facts {
+        let mut f = Facts::default();
+        for (name, t) in rows {
+            f.add(name, t.clone(), Origin::Rust);
+        }
+        f
+    }
+
+    /// An upright's box: length plumb, width along `width` (horizontal).
+    fn upright(width: Vector3<f64>) -> Value {
+        let x = Vector3::z();
+        let m = nalgebra::Matrix3::from_columns(&[x, width, x.cross(&width)]);
+        let pose = nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::identity(),
+            nalgebra::UnitQuaternion::from_matrix(&m),
+        );
+        Value::Box(std::sync::Arc::new(OBox {
+            pose,
+            half: Vector3::new(1.2, 0.045, 0.019),
+        }))
+    }
+
+    #[test]
+    fn coplanar_contacts_and_groups_join_pieces_of_one_container_only() {
+        let s = Value::sym;
+        let contact = |a: &str, b: &str| {
+            (
+                "contact",
+                vec![s(a), s(b), s("k"), s("end"), s("wide"), Value::float(0.0)],
+            )
+        };
+        let f = facts(&[
+            ("piece_container", vec![s("a"), s("S1")]),
+            ("piece_container", vec![s("b"), s("S1")]),
+            ("piece_container", vec![s("c"), s("S1")]),
+            ("piece_container", vec![s("d"), s("S1")]),
+            ("piece_container", vec![s("e"), s("S2")]),
+            ("piece_container", vec![s("f"), s("S1")]),
+            ("piece_box", vec![s("a"), upright(Vector3::x())]),
+            ("piece_box", vec![s("b"), upright(-Vector3::x())]),
+            ("piece_box", vec![s("e"), upright(Vector3::x())]),
+            ("piece_box", vec![s("f"), upright(Vector3::y())]),
+            ("piece_index", vec![s("a"), Value::Number(4)]),
+            ("piece_index", vec![s("c"), Value::Number(9)]),
+            ("piece_index", vec![s("d"), Value::Number(7)]),
+            contact("a", "b"),
+            contact("b", "e"),
+            contact("a", "f"),
+            ("piece_group", vec![s("c"), s("G"), s("IFCWALL"), s("")]),
+            ("piece_group", vec![s("d"), s("G"), s("IFCWALL"), s("")]),
+            ("cell_value", vec![s("x"), Value::float(1.0)]),
+        ]);
+        let p = Partition::of(&f);
+        let pieces: Vec<Vec<String>> = p.parts.iter().map(|q| q.pieces.clone()).collect();
+        assert_eq!(
+            pieces,
+            vec![vec!["a", "b"], vec!["c", "d"], vec!["e"], vec!["f"]]
+        );
+        assert_eq!(p.parts[1].groups, vec!["G"]);
+        // The contact across containers and the one across walls (a crossing upright) go
+        // nowhere; the cell goes everywhere.
+        assert_eq!(p.parts[0].relations["contact"].len(), 1);
+        assert!(p.parts[2].relations["contact"].is_empty());
+        assert!(p.parts[3].relations["contact"].is_empty());
+        assert!(p.parts.iter().all(|q| q.relations["cell_value"].len() == 1));
+        // Indices renumbered within the part, in file order.
+        let idx = &p.parts[1].relations["piece_index"];
+        assert_eq!(
+            idx,
+            &vec![
+                vec![s("c"), Value::Number(1)],
+                vec![s("d"), Value::Number(0)]
+            ]
+        );
+        // Context of part 0: the other pieces of S1 (c, d, f), never e or a, b.
+        let ctx = p.context(&f, 0);
+        let ids: Vec<&str> = ctx["piece_container"]
+            .iter()
+            .filter_map(|t| t[0].as_symbol())
+            .collect();
+        assert_eq!(ids, vec!["c", "d", "f"]);
+    }
+}
