@@ -9,6 +9,7 @@ use crate::frame::plan;
 use crate::sim::SimOptions;
 use crate::world::{ScenePiece, SceneWall};
 use std::fmt::Write as _;
+use std::path::Path;
 use std::sync::OnceLock;
 
 /// Feeds formatted text into a hash without building the string.
@@ -25,21 +26,78 @@ impl std::fmt::Write for HashText<'_> {
 /// another build (whose executor or kinematics may differ) are never reused. When the
 /// executable cannot be read, the identity is unique to this process: nothing is reused.
 pub fn build_id() -> &'static str {
-    static ID: OnceLock<String> = OnceLock::new();
-    ID.get_or_init(|| {
-        let mut h = blake3::Hasher::new();
-        h.update(env!("CARGO_PKG_VERSION").as_bytes());
-        let hashed = std::env::current_exe()
-            .ok()
-            .and_then(|exe| h.update_mmap_rayon(exe).ok().map(|_| ()));
-        if hashed.is_none() {
-            let now = std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map_or(0, |d| d.as_nanos());
-            h.update(format!("unreadable build {} {now}", std::process::id()).as_bytes());
+    BUILD_ID.get_or_init(hash_executable)
+}
+
+static BUILD_ID: OnceLock<String> = OnceLock::new();
+
+/// `build_id`, taken from a note in the cache folder `dir` when this executable file (same
+/// path, size, inode, modification and change times) was hashed before: hashing a 100 MB
+/// executable is most of a cached `plan`'s time. A rebuilt or replaced executable has new
+/// times, so it is hashed again; a note that cannot be read or written only costs the hash.
+pub fn build_id_noted(dir: &Path) -> &'static str {
+    BUILD_ID.get_or_init(|| {
+        let Some(note) = executable_stamp().map(|s| dir.join(BUILDS).join(s)) else {
+            return hash_executable();
+        };
+        if let Ok(text) = std::fs::read_to_string(&note)
+            && text.len() == 64
+            && text.bytes().all(|b| b.is_ascii_hexdigit())
+        {
+            return text;
         }
-        h.finalize().to_hex().to_string()
+        let id = hash_executable();
+        if let Some(folder) = note.parent()
+            && std::fs::create_dir_all(folder).is_ok()
+        {
+            let _ = crate::atomic::write_atomically_with(&note, |w| w.write_all(id.as_bytes()));
+        }
+        id
     })
+}
+
+/// Subfolder of the build notes.
+pub const BUILDS: &str = "builds";
+
+/// A name for the running executable file as it is now: a hash of its path and metadata.
+#[cfg(not(unix))]
+fn executable_stamp() -> Option<String> {
+    None
+}
+
+/// A name for the running executable file as it is now: a hash of its path and metadata.
+#[cfg(unix)]
+fn executable_stamp() -> Option<String> {
+    use std::os::unix::fs::MetadataExt;
+    let exe = std::env::current_exe().ok()?;
+    let m = std::fs::metadata(&exe).ok()?;
+    let text = format!(
+        "{}\0{}\0{}\0{}\0{}.{}\0{}.{}",
+        exe.display(),
+        m.len(),
+        m.dev(),
+        m.ino(),
+        m.mtime(),
+        m.mtime_nsec(),
+        m.ctime(),
+        m.ctime_nsec()
+    );
+    Some(blake3::hash(text.as_bytes()).to_hex().to_string())
+}
+
+fn hash_executable() -> String {
+    let mut h = blake3::Hasher::new();
+    h.update(env!("CARGO_PKG_VERSION").as_bytes());
+    let hashed = std::env::current_exe()
+        .ok()
+        .and_then(|exe| h.update_mmap_rayon(exe).ok().map(|_| ()));
+    if hashed.is_none() {
+        let now = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        h.update(format!("unreadable build {} {now}", std::process::id()).as_bytes());
+    }
+    h.finalize().to_hex().to_string()
 }
 
 /// The key of one wall's simulation.

@@ -7,14 +7,14 @@
 //! still reaches exactly that far. An edit to one wall recomputes that wall's part (and the
 //! parts whose storey extent it moved), nothing else.
 
-use super::key::build_id;
+use super::key::build_id_noted;
 use super::value_codec::{Reader, put_relations, put_str};
 use super::{Cache, CacheCounts};
 use crate::cell::{Cell, OffsetX};
 use crate::frame::partition::{Part, Partition};
 use crate::frame::placement::{SearchOptions, placement_facts_with};
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, FrameError, Reasoned, RuleLimits};
+use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, RuleLimits, reason_within};
 use crate::logic::compiled::{Relations, builtin};
 use crate::logic::functors::defs::{box_centre, box_radius, dot};
 use crate::logic::value::{F64, OBox, Value, Vec3};
@@ -48,7 +48,7 @@ pub fn reason_plan_cached(
     limits: &RuleLimits,
 ) -> Result<(Reasoned, CacheCounts), FrameError> {
     let partition = Partition::of(facts);
-    let base = base_key(cell);
+    let base = base_key(cell, build_id_noted(cache.dir()));
     let keys: Vec<String> = partition
         .parts
         .par_iter()
@@ -84,6 +84,31 @@ pub fn reason_plan_cached(
         .flatten()
         .map(|r| r.get("wall").map_or(0, Vec::len))
         .sum();
+
+    // Nothing cached (a first run): reason the model as `plan` does without the cache (one
+    // placement search over every wall, so repeated walls search once) and store its parts.
+    if results.iter().all(Option::is_none) {
+        let mut facts = facts.clone();
+        crate::frame::placement::add_placement_facts(&mut facts, cell, &RuleEngine::Compiled)?;
+        let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
+        wanted.push(REACH);
+        let mut reasoned =
+            reason_within(&facts, &RuleEngine::Compiled, false, Some(&wanted), limits)?;
+        let everything: Vec<usize> = (0..partition.parts.len()).collect();
+        let parts = split(&partition, &everything, reasoned.relations.clone());
+        parts.par_iter().for_each(|(i, relations)| {
+            cache.put_plan(&keys[*i], &encode(&keys[*i], relations));
+        });
+        let walls = |r: &Relations| r.get("wall").map_or(0, Vec::len);
+        counts.rejected = parts
+            .iter()
+            .filter(|(i, _)| rejected[*i])
+            .map(|(_, r)| walls(r))
+            .sum();
+        reasoned.relations.remove(REACH);
+        counts.computed = walls(&reasoned.relations);
+        return Ok((reasoned, counts));
+    }
 
     // What to compute: whole containers where many parts missed, single parts elsewhere.
     let mut jobs: Vec<Job> = Vec::new();
@@ -269,31 +294,43 @@ fn reason_part(mut input: Relations, cell: &Cell) -> Result<(Relations, u64), Fr
     Ok((second.relations, tuples + second.tuples))
 }
 
-/// A container's relations split by part: a tuple goes to the part of the first piece or
-/// group it names; a tuple naming none (the storey's reach, what the cell alone gives) to
-/// every part.
+/// Relations split by part (of `parts`): a tuple goes to the part of the first piece or
+/// group it names; a storey's reach row to every part of that storey; a tuple naming none
+/// (what the cell alone gives) to every part.
 fn split(partition: &Partition, parts: &[usize], out: Relations) -> Vec<(usize, Relations)> {
     let mut owner: FxHashMap<&str, usize> = FxHashMap::default();
+    let mut of_container: FxHashMap<&str, Vec<usize>> = FxHashMap::default();
     for (k, &i) in parts.iter().enumerate() {
         let part = &partition.parts[i];
         for id in part.pieces.iter().chain(&part.groups) {
             owner.insert(id.as_str(), k);
         }
+        let container = partition.containers[part.container].name.as_str();
+        of_container.entry(container).or_default().push(k);
     }
+    let everyone: Vec<usize> = (0..parts.len()).collect();
     let mut split: Vec<Relations> = vec![Relations::new(); parts.len()];
     for (name, rows) in out {
         for r in split.iter_mut() {
             r.insert(name.clone(), Vec::new());
         }
         for t in rows {
-            let of = t
-                .iter()
-                .find_map(|v| v.as_symbol().and_then(|s| owner.get(s)).copied());
-            match of {
-                Some(k) => split[k].get_mut(&name).expect("inserted").push(t),
-                None => split.iter_mut().for_each(|r| {
-                    r.get_mut(&name).expect("inserted").push(t.clone());
-                }),
+            let to: &[usize] = if name == REACH {
+                t.first()
+                    .and_then(Value::as_symbol)
+                    .and_then(|c| of_container.get(c))
+                    .map_or(&[], Vec::as_slice)
+            } else {
+                match t
+                    .iter()
+                    .find_map(|v| v.as_symbol().and_then(|s| owner.get(s)))
+                {
+                    Some(k) => std::slice::from_ref(k),
+                    None => &everyone,
+                }
+            };
+            for &k in to {
+                split[k].get_mut(&name).expect("inserted").push(t.clone());
             }
         }
     }
@@ -336,10 +373,10 @@ fn merge(partition: &Partition, results: Vec<Option<Relations>>) -> Relations {
 
 /// What every part's key shares: the format, the build, the cell (its facts and what the
 /// placement search reads: robot, tool, offsets) and the search options.
-fn base_key(cell: &Cell) -> blake3::Hasher {
+fn base_key(cell: &Cell, build: &str) -> blake3::Hasher {
     let mut h = blake3::Hasher::new();
     h.update(b"framewright plan part\0");
-    h.update(build_id().as_bytes());
+    h.update(build.as_bytes());
     h.update(format!("\0{cell:?}\0{:?}\0", SearchOptions::default()).as_bytes());
     h
 }
@@ -638,6 +675,34 @@ mod tests {
         assert_eq!(edited.relations, want);
         assert_eq!(counts.computed, 1, "only the stud's wall is reasoned again");
         assert_eq!(counts.cached, walls - 1);
+
+        // Half the entries gone: whole storeys are reasoned again, split and stored.
+        let mut files: Vec<std::path::PathBuf> = walkdir(&dir.path().join("plans"));
+        files.sort();
+        for f in files.iter().step_by(2) {
+            std::fs::remove_file(f).unwrap();
+        }
+        let (again, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        assert_eq!(again.relations, want);
+        assert!(
+            counts.computed > walls / 4 && counts.cached > 0,
+            "{counts:?}"
+        );
+        let (warm, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        assert_eq!(warm.relations, want);
+        assert_eq!((counts.computed, counts.cached), (0, walls));
+    }
+
+    fn walkdir(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+        let mut out = Vec::new();
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            if e.path().is_dir() {
+                out.extend(walkdir(&e.path()));
+            } else {
+                out.push(e.path());
+            }
+        }
+        out
     }
 
     #[test]

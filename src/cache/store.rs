@@ -187,6 +187,16 @@ pub fn clear(dir: &Path) -> std::io::Result<u64> {
             Err(e) => return Err(e),
         }
     }
+    // The notes of hashed executables (`key::build_id_noted`) go too, uncounted.
+    if let Ok(notes) = std::fs::read_dir(dir.join(super::key::BUILDS)) {
+        for note in notes.flatten() {
+            let name = note.file_name().to_string_lossy().into_owned();
+            if name.len() == 64 && name.bytes().all(|b| b.is_ascii_hexdigit()) {
+                let _ = std::fs::remove_file(note.path());
+            }
+        }
+        let _ = std::fs::remove_dir(dir.join(super::key::BUILDS));
+    }
     // Now-empty fan-out folders go too; a folder something else put files in stays.
     for folder in [WALLS, PLANS] {
         if let Ok(subdirs) = std::fs::read_dir(dir.join(folder)) {
