@@ -1,20 +1,23 @@
 //! Regeneration after a design edit, measured in one run on the 3-storey model
 //! (`../shared/ifc-testcases/g_scale_3storey.ifc`, skipped when absent):
 //!
-//! 1. the full simulation, filling an empty cache (what a first `simulate` costs);
-//! 2. one interior stud moved 20 mm along its wall, simulated again through the cache;
-//! 3. `plan` of the edited model (read, facts, rules, plan);
+//! 1. one interior stud moved 20 mm along its wall; `plan` of the edited model (read, facts,
+//!    placement search, rules, plan) without the cache, and through a plan cache filled
+//!    from the original model;
+//! 2. the full simulation, filling an empty cache (what a first `simulate` costs);
+//! 3. the edited model simulated again through the cache;
 //! 4. the edited model simulated without the cache: its report must equal the regenerated
 //!    one byte for byte (apart from the cache counts).
 //!
-//! Run: `cargo bench --bench regenerate` (about three full simulations; run it alone).
+//! Run: `cargo bench --bench regenerate` (about three full simulations; run it alone;
+//! `-- --plan-only` for the plan rows alone).
 //! The full simulation is not repeated: this is a bench command, not a criterion sample.
 
-use framewright::cache::{Cache, simulate_cached};
+use framewright::cache::{Cache, reason_plan_cached, simulate_cached};
 use framewright::cell::Cell;
 use framewright::frame::placement::add_placement_facts;
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, cell_facts, model_facts, reason_selected};
+use framewright::frame::{RuleEngine, RuleLimits, cell_facts, model_facts, reason_selected};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::report::simulate::SimReport;
@@ -88,6 +91,48 @@ fn move_a_stud(text: &str) -> (String, String) {
     (text.replacen(&old, &new, 1), global_id.clone())
 }
 
+/// The plan rows: `plan` as the command runs it (read, facts, placement search, rules,
+/// plan) on the edited model without the cache, then through a plan cache filled from the
+/// original model, each once.
+fn plan_rows(path: &Path, edited_path: &Path, dir: &Path, cell: &Cell) {
+    let plan_once = |model_path: &Path, cache: Option<&Cache>| {
+        let t = Instant::now();
+        let m = Model::open(model_path).unwrap();
+        let mut facts = model_facts(&m, &ContactOptions::default());
+        facts.extend(cell_facts(cell));
+        let (reasoned, counts) = match cache {
+            Some(cache) => {
+                let (r, c) =
+                    reason_plan_cached(&facts, cell, cache, &RuleLimits::default()).unwrap();
+                (r, Some(c))
+            }
+            None => {
+                add_placement_facts(&mut facts, cell, &RuleEngine::Compiled).unwrap();
+                let r = reason_selected(&facts, &RuleEngine::Compiled, Plan::RELATIONS).unwrap();
+                (r, None)
+            }
+        };
+        let plan = Plan::from_reasoned(&m, &reasoned);
+        (t.elapsed().as_secs_f64(), plan.walls.len(), counts)
+    };
+    let plan_cache = Cache::new(dir.join("plan-cache"));
+    let (full_plan_s, walls, _) = plan_once(edited_path, None);
+    let (fill_s, _, _) = plan_once(path, Some(&plan_cache));
+    let (regen_plan_s, _, counts) = plan_once(edited_path, Some(&plan_cache));
+    let counts = counts.unwrap();
+    println!(
+        "plan of the edited model: {:.0} ms without the cache, {walls} walls; first plan into \
+         an empty cache {:.0} ms; regenerated through the cache {:.0} ms ({:.1} % of the full \
+         plan), {} walls reasoned, {} from the cache",
+        full_plan_s * 1000.0,
+        fill_s * 1000.0,
+        regen_plan_s * 1000.0,
+        100.0 * regen_plan_s / full_plan_s,
+        counts.computed,
+        counts.cached
+    );
+}
+
 fn main() {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/ifc-testcases/g_scale_3storey.ifc");
@@ -106,6 +151,14 @@ fn main() {
     let name = "g_scale_3storey.ifc";
     let nothing = |_: &str, _: usize, _: usize| {};
 
+    let (edited_text, stud) = move_a_stud(&std::fs::read_to_string(&path).unwrap());
+    let edited_path = dir.path().join(name);
+    std::fs::write(&edited_path, edited_text).unwrap();
+    plan_rows(&path, &edited_path, dir.path(), &cell);
+    if std::env::args().any(|a| a == "--plan-only") {
+        return;
+    }
+
     let t = Instant::now();
     let model = Model::open(&path).unwrap();
     let (full, counts) = simulate_cached(&model, name, &cell, &options, &cache, &nothing).unwrap();
@@ -116,9 +169,6 @@ fn main() {
     );
     drop(full);
 
-    let (edited_text, stud) = move_a_stud(&std::fs::read_to_string(&path).unwrap());
-    let edited_path = dir.path().join(name);
-    std::fs::write(&edited_path, edited_text).unwrap();
     let t = Instant::now();
     let edited = Model::open(&edited_path).unwrap();
     let (regen, counts) =
@@ -130,20 +180,6 @@ fn main() {
         100.0 * regen_s / full_s,
         counts.computed,
         counts.cached
-    );
-
-    let t = Instant::now();
-    let m = Model::open(&edited_path).unwrap();
-    let mut facts = model_facts(&m, &ContactOptions::default());
-    facts.extend(cell_facts(&cell));
-    // As `plan` runs: the placement search, then only the relations the plan reads.
-    add_placement_facts(&mut facts, &cell, &RuleEngine::Compiled).unwrap();
-    let reasoned = reason_selected(&facts, &RuleEngine::Compiled, Plan::RELATIONS).unwrap();
-    let plan = Plan::from_reasoned(&m, &reasoned);
-    println!(
-        "plan of the edited model (no plan cache yet): {:.0} ms, {} walls",
-        t.elapsed().as_secs_f64() * 1000.0,
-        plan.walls.len()
     );
 
     let t = Instant::now();
