@@ -48,7 +48,7 @@ pub fn reason_plan_cached(
     limits: &RuleLimits,
 ) -> Result<(Reasoned, CacheCounts), FrameError> {
     let partition = Partition::of(facts);
-    let base = base_key(cell, build_id_noted(cache.dir()));
+    let base = base_key(cell, build_id_noted(cache.dir()), limits);
     let keys: Vec<String> = partition
         .parts
         .par_iter()
@@ -372,12 +372,21 @@ fn merge(partition: &Partition, results: Vec<Option<Relations>>) -> Relations {
 }
 
 /// What every part's key shares: the format, the build, the cell (its facts and what the
-/// placement search reads: robot, tool, offsets) and the search options.
-fn base_key(cell: &Cell, build: &str) -> blake3::Hasher {
+/// placement search reads: robot, tool, offsets), the search options, and the rule tuple
+/// bound (a run under a lower bound must stop where an uncached run stops, not read a result
+/// derived under a higher one; the wall bound is checked on every run).
+fn base_key(cell: &Cell, build: &str, limits: &RuleLimits) -> blake3::Hasher {
     let mut h = blake3::Hasher::new();
     h.update(b"framewright plan part\0");
     h.update(build.as_bytes());
-    h.update(format!("\0{cell:?}\0{:?}\0", SearchOptions::default()).as_bytes());
+    h.update(
+        format!(
+            "\0{cell:?}\0{:?}\0{}\0",
+            SearchOptions::default(),
+            limits.max_rule_tuples
+        )
+        .as_bytes(),
+    );
     h
 }
 
