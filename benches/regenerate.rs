@@ -103,7 +103,7 @@ fn plan_rows(path: &Path, edited_path: &Path, dir: &Path, cell: &Cell) {
         let (reasoned, counts) = match cache {
             Some(cache) => {
                 let (r, c) =
-                    reason_plan_cached(&facts, cell, cache, &RuleLimits::default()).unwrap();
+                    reason_plan_cached(facts, cell, cache, &RuleLimits::default()).unwrap();
                 (r, Some(c))
             }
             None => {

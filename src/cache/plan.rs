@@ -8,7 +8,7 @@
 //! parts whose storey extent it moved), nothing else.
 
 use super::key::build_id_noted;
-use super::value_codec::{Reader, put_relations, put_str};
+use super::value_codec::{Reader, put_relations, put_str, put_tuple, put_u64};
 use super::{Cache, CacheCounts};
 use crate::cell::{Cell, OffsetX};
 use crate::frame::partition::{Part, Partition};
@@ -42,19 +42,19 @@ const WHOLE_CONTAINER_SHARE: f64 = 0.25;
 /// how many walls were reasoned and how many came from the cache. `facts` are the model's
 /// and the cell's, without placement facts (the search runs per part here).
 pub fn reason_plan_cached(
-    facts: &Facts,
+    facts: Facts,
     cell: &Cell,
     cache: &Cache,
     limits: &RuleLimits,
 ) -> Result<(Reasoned, CacheCounts), FrameError> {
-    let partition = Partition::of(facts);
+    let mut partition = Partition::of(&facts);
     let base = base_key(cell, build_id_noted(cache.dir()), limits);
     let keys: Vec<String> = partition
         .parts
         .par_iter()
         .map(|p| part_key(&base, p))
         .collect();
-    let extents = Extents::of(facts, &partition);
+    let extents = Extents::of(&facts, &partition);
     let mut counts = CacheCounts::default();
     // Each part's relations (with its storey_reach rows), from the cache or computed.
     let looked: Vec<Found> = keys
@@ -88,25 +88,35 @@ pub fn reason_plan_cached(
     // Nothing cached (a first run): reason the model as `plan` does without the cache (one
     // placement search over every wall, so repeated walls search once) and store its parts.
     if results.iter().all(Option::is_none) {
-        let mut facts = facts.clone();
+        // The parts' own copies of the facts are not needed any more: keys are made.
+        for part in &mut partition.parts {
+            part.relations = Relations::new();
+        }
+        let mut facts = facts;
         crate::frame::placement::add_placement_facts(&mut facts, cell, &RuleEngine::Compiled)?;
         let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
         wanted.push(REACH);
         let mut reasoned =
             reason_within(&facts, &RuleEngine::Compiled, false, Some(&wanted), limits)?;
+        drop(facts);
         let everything: Vec<usize> = (0..partition.parts.len()).collect();
-        let parts = split(&partition, &everything, reasoned.relations.clone());
-        parts.par_iter().for_each(|(i, relations)| {
-            cache.put_plan(&keys[*i], &encode(&keys[*i], relations));
-        });
-        let walls = |r: &Relations| r.get("wall").map_or(0, Vec::len);
-        counts.rejected = parts
-            .iter()
-            .filter(|(i, _)| rejected[*i])
-            .map(|(_, r)| walls(r))
+        let shares = shares(&partition, &everything, &reasoned.relations);
+        let wall_slot = reasoned.relations.keys().position(|n| n == "wall");
+        let walls: Vec<usize> = shares
+            .par_iter()
+            .enumerate()
+            .map(|(i, share)| {
+                let bytes = encode_share(&keys[i], &reasoned.relations, share);
+                cache.put_plan(&keys[i], &bytes);
+                share.iter().filter(|(r, _)| Some(*r) == wall_slot).count()
+            })
+            .collect();
+        counts.rejected = (0..walls.len())
+            .filter(|&i| rejected[i])
+            .map(|i| walls[i])
             .sum();
         reasoned.relations.remove(REACH);
-        counts.computed = walls(&reasoned.relations);
+        counts.computed = reasoned.get("wall").len();
         return Ok((reasoned, counts));
     }
 
@@ -138,7 +148,7 @@ pub fn reason_plan_cached(
     let computed: Mutex<Vec<(usize, Relations)>> = Mutex::new(Vec::new());
     jobs.par_iter()
         .try_for_each(|job| -> Result<(), FrameError> {
-            let (done, tuples) = job.run(facts, &partition, cell)?;
+            let (done, tuples) = job.run(&facts, &partition, cell)?;
             let sum = total.fetch_add(tuples, std::sync::atomic::Ordering::Relaxed) + tuples;
             limits.check_tuples(sum)?;
             for (i, relations) in &done {
@@ -241,7 +251,13 @@ impl Job {
                         .collect(),
                 );
                 let (out, tuples) = reason_part(input, cell)?;
-                Ok((split(partition, parts, out), tuples))
+                let shares = shares(partition, parts, &out);
+                let split = parts
+                    .iter()
+                    .zip(shares)
+                    .map(|(&i, share)| (i, owned_share(&out, &share)))
+                    .collect();
+                Ok((split, tuples))
             }
             Job::Part(i) => {
                 let mut input = partition.parts[*i].relations.clone();
@@ -294,10 +310,12 @@ fn reason_part(mut input: Relations, cell: &Cell) -> Result<(Relations, u64), Fr
     Ok((second.relations, tuples + second.tuples))
 }
 
-/// Relations split by part (of `parts`): a tuple goes to the part of the first piece or
-/// group it names; a storey's reach row to every part of that storey; a tuple naming none
-/// (what the cell alone gives) to every part.
-fn split(partition: &Partition, parts: &[usize], out: Relations) -> Vec<(usize, Relations)> {
+/// Which tuples of `out` belong to each of `parts`, as (relation slot, tuple index) pairs in
+/// relation order (slots count `out`'s relations in name order): a tuple goes to the part of
+/// the first piece or group it names; a storey's reach row to every part of that storey; a
+/// tuple naming none (what the cell alone gives) to every part. References, not copies: a
+/// whole model's relations are split without holding them twice.
+fn shares(partition: &Partition, parts: &[usize], out: &Relations) -> Vec<Vec<(usize, usize)>> {
     let mut owner: FxHashMap<&str, usize> = FxHashMap::default();
     let mut of_container: FxHashMap<&str, Vec<usize>> = FxHashMap::default();
     for (k, &i) in parts.iter().enumerate() {
@@ -309,12 +327,9 @@ fn split(partition: &Partition, parts: &[usize], out: Relations) -> Vec<(usize, 
         of_container.entry(container).or_default().push(k);
     }
     let everyone: Vec<usize> = (0..parts.len()).collect();
-    let mut split: Vec<Relations> = vec![Relations::new(); parts.len()];
-    for (name, rows) in out {
-        for r in split.iter_mut() {
-            r.insert(name.clone(), Vec::new());
-        }
-        for t in rows {
+    let mut shares: Vec<Vec<(usize, usize)>> = vec![Vec::new(); parts.len()];
+    for (slot, (name, rows)) in out.iter().enumerate() {
+        for (row, t) in rows.iter().enumerate() {
             let to: &[usize] = if name == REACH {
                 t.first()
                     .and_then(Value::as_symbol)
@@ -330,11 +345,24 @@ fn split(partition: &Partition, parts: &[usize], out: Relations) -> Vec<(usize, 
                 }
             };
             for &k in to {
-                split[k].get_mut(&name).expect("inserted").push(t.clone());
+                shares[k].push((slot, row));
             }
         }
     }
-    parts.iter().copied().zip(split).collect()
+    shares
+}
+
+/// A part's share of `out` as its own relations (every relation of `out`, maybe empty).
+fn owned_share(out: &Relations, share: &[(usize, usize)]) -> Relations {
+    let rows: Vec<&Vec<Vec<Value>>> = out.values().collect();
+    let mut r: Relations = out.keys().map(|n| (n.clone(), Vec::new())).collect();
+    let slots: Vec<&String> = out.keys().collect();
+    for &(slot, row) in share {
+        r.get_mut(slots[slot])
+            .expect("every relation")
+            .push(rows[slot][row].clone());
+    }
+    r
 }
 
 /// The parts' relations as the container-by-container run returns them: containers
@@ -403,9 +431,34 @@ fn encode(key: &str, relations: &Relations) -> Vec<u8> {
     let mut out = MAGIC.to_vec();
     put_str(&mut out, key);
     put_relations(&mut out, relations);
-    let digest = blake3::hash(&out);
-    out.extend_from_slice(digest.as_bytes());
-    out
+    seal(out)
+}
+
+/// `encode` of a part's share of a run's relations, read in place.
+fn encode_share(key: &str, out: &Relations, share: &[(usize, usize)]) -> Vec<u8> {
+    let mut bytes = MAGIC.to_vec();
+    put_str(&mut bytes, key);
+    put_u64(&mut bytes, out.len() as u64);
+    let mut next = 0;
+    for (slot, (name, rows)) in out.iter().enumerate() {
+        let start = next;
+        while next < share.len() && share[next].0 == slot {
+            next += 1;
+        }
+        put_str(&mut bytes, name);
+        put_u64(&mut bytes, (next - start) as u64);
+        for &(_, row) in &share[start..next] {
+            put_tuple(&mut bytes, &rows[row]);
+        }
+    }
+    seal(bytes)
+}
+
+/// An entry's bytes followed by their blake3 digest.
+fn seal(mut bytes: Vec<u8>) -> Vec<u8> {
+    let digest = blake3::hash(&bytes);
+    bytes.extend_from_slice(digest.as_bytes());
+    bytes
 }
 
 /// An entry's relations, or None when it is torn, altered, of another format or key.
@@ -654,11 +707,11 @@ mod tests {
         let cache = Cache::new(dir.path());
         let limits = RuleLimits::default();
         let want = uncached(&facts, &cell);
-        let (cold, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        let (cold, counts) = reason_plan_cached(facts.clone(), &cell, &cache, &limits).unwrap();
         assert_eq!(cold.relations, want);
         let walls = want["wall"].len();
         assert_eq!((counts.computed, counts.cached), (walls, 0));
-        let (warm, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        let (warm, counts) = reason_plan_cached(facts.clone(), &cell, &cache, &limits).unwrap();
         assert_eq!(warm.relations, want);
         assert_eq!((counts.computed, counts.cached), (0, walls));
 
@@ -680,7 +733,7 @@ mod tests {
             }
         }
         let want = uncached(&facts, &cell);
-        let (edited, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        let (edited, counts) = reason_plan_cached(facts.clone(), &cell, &cache, &limits).unwrap();
         assert_eq!(edited.relations, want);
         assert_eq!(counts.computed, 1, "only the stud's wall is reasoned again");
         assert_eq!(counts.cached, walls - 1);
@@ -691,13 +744,13 @@ mod tests {
         for f in files.iter().step_by(2) {
             std::fs::remove_file(f).unwrap();
         }
-        let (again, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        let (again, counts) = reason_plan_cached(facts.clone(), &cell, &cache, &limits).unwrap();
         assert_eq!(again.relations, want);
         assert!(
             counts.computed > walls / 4 && counts.cached > 0,
             "{counts:?}"
         );
-        let (warm, counts) = reason_plan_cached(&facts, &cell, &cache, &limits).unwrap();
+        let (warm, counts) = reason_plan_cached(facts.clone(), &cell, &cache, &limits).unwrap();
         assert_eq!(warm.relations, want);
         assert_eq!((counts.computed, counts.cached), (0, walls));
     }
@@ -712,6 +765,28 @@ mod tests {
             }
         }
         out
+    }
+
+    /// A share written in place is the entry its owned copy gives.
+    #[test]
+    fn a_share_encodes_as_its_owned_relations() {
+        let cell = Cell::load("study-abb").unwrap();
+        let facts = facts_of(&small_block(), &cell);
+        let partition = Partition::of(&facts);
+        let out = uncached(&facts, &cell);
+        let parts: Vec<usize> = (0..partition.parts.len()).collect();
+        let shares = shares(&partition, &parts, &out);
+        let mut walls = 0;
+        for (k, share) in shares.iter().enumerate() {
+            let owned = owned_share(&out, share);
+            walls += owned["wall"].len();
+            assert_eq!(
+                encode_share("k", &out, share),
+                encode("k", &owned),
+                "part {k}"
+            );
+        }
+        assert_eq!(walls, out["wall"].len(), "every wall in one part");
     }
 
     #[test]

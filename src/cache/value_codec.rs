@@ -17,14 +17,19 @@ pub fn put_relations(out: &mut Vec<u8>, relations: &Relations) {
     }
 }
 
-/// Appends tuples: count, then per tuple its arity and values.
+/// Appends tuples: count, then each tuple.
 pub fn put_tuples(out: &mut Vec<u8>, tuples: &[Vec<Value>]) {
     put_u64(out, tuples.len() as u64);
     for t in tuples {
-        put_u64(out, t.len() as u64);
-        for v in t {
-            put_value(out, v);
-        }
+        put_tuple(out, t);
+    }
+}
+
+/// Appends one tuple: its arity and values.
+pub fn put_tuple(out: &mut Vec<u8>, t: &[Value]) {
+    put_u64(out, t.len() as u64);
+    for v in t {
+        put_value(out, v);
     }
 }
 

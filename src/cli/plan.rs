@@ -29,7 +29,7 @@ pub struct PlanArgs {
 
 pub fn run(args: PlanArgs) -> CmdResult {
     let inputs = &args.inputs;
-    let (model, cell, mut facts) = load_model_facts(&args.model, inputs)?;
+    let (model, cell, facts) = load_model_facts(&args.model, inputs)?;
     let cache = match inputs.rules_dir {
         None => args.cache.open(),
         Some(_) => None,
@@ -37,11 +37,12 @@ pub fn run(args: PlanArgs) -> CmdResult {
     let (reasoned, counts) = match &cache {
         Some(cache) => {
             let (reasoned, counts) =
-                reason_plan_cached(&facts, &cell, cache, &RuleLimits::from_env()?)?;
+                reason_plan_cached(facts, &cell, cache, &RuleLimits::from_env()?)?;
             (reasoned, Some(counts))
         }
         None => {
             let engine = rule_base(&inputs.rules_dir);
+            let mut facts = facts;
             add_placement_facts(&mut facts, &cell, &engine)?;
             (reason_selected(&facts, &engine, Plan::RELATIONS)?, None)
         }
