@@ -85,39 +85,8 @@ pub fn reason_plan_cached(
         .map(|r| r.get("wall").map_or(0, Vec::len))
         .sum();
 
-    // Nothing cached (a first run): reason the model as `plan` does without the cache (one
-    // placement search over every wall, so repeated walls search once) and store its parts.
     if results.iter().all(Option::is_none) {
-        // The parts' own copies of the facts are not needed any more: keys are made.
-        for part in &mut partition.parts {
-            part.relations = Relations::new();
-        }
-        let mut facts = facts;
-        crate::frame::placement::add_placement_facts(&mut facts, cell, &RuleEngine::Compiled)?;
-        let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
-        wanted.push(REACH);
-        let mut reasoned =
-            reason_within(&facts, &RuleEngine::Compiled, false, Some(&wanted), limits)?;
-        drop(facts);
-        let everything: Vec<usize> = (0..partition.parts.len()).collect();
-        let shares = shares(&partition, &everything, &reasoned.relations);
-        let wall_slot = reasoned.relations.keys().position(|n| n == "wall");
-        let walls: Vec<usize> = shares
-            .par_iter()
-            .enumerate()
-            .map(|(i, share)| {
-                let bytes = encode_share(&keys[i], &reasoned.relations, share);
-                cache.put_plan(&keys[i], &bytes);
-                share.iter().filter(|(r, _)| Some(*r) == wall_slot).count()
-            })
-            .collect();
-        counts.rejected = (0..walls.len())
-            .filter(|&i| rejected[i])
-            .map(|i| walls[i])
-            .sum();
-        reasoned.relations.remove(REACH);
-        counts.computed = reasoned.get("wall").len();
-        return Ok((reasoned, counts));
+        return first_run(facts, cell, cache, limits, &mut partition, &keys, &rejected);
     }
 
     // What to compute: whole containers where many parts missed, single parts elsewhere.
@@ -189,6 +158,48 @@ enum Found {
 
 fn poisoned() -> FrameError {
     FrameError::Compiled("a reasoning thread failed".into())
+}
+
+/// A first run (nothing cached): the model reasoned as `plan` does without the cache (one
+/// placement search over every wall, so repeated walls search once), its parts stored.
+fn first_run(
+    mut facts: Facts,
+    cell: &Cell,
+    cache: &Cache,
+    limits: &RuleLimits,
+    partition: &mut Partition,
+    keys: &[String],
+    rejected: &[bool],
+) -> Result<(Reasoned, CacheCounts), FrameError> {
+    let mut counts = CacheCounts::default();
+    // The parts' own copies of the facts are not needed any more: keys are made.
+    for part in &mut partition.parts {
+        part.relations = Relations::new();
+    }
+    crate::frame::placement::add_placement_facts(&mut facts, cell, &RuleEngine::Compiled)?;
+    let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
+    wanted.push(REACH);
+    let mut reasoned = reason_within(&facts, &RuleEngine::Compiled, false, Some(&wanted), limits)?;
+    drop(facts);
+    let everything: Vec<usize> = (0..partition.parts.len()).collect();
+    let shares = shares(partition, &everything, &reasoned.relations);
+    let wall_slot = reasoned.relations.keys().position(|n| n == "wall");
+    let walls: Vec<usize> = shares
+        .par_iter()
+        .enumerate()
+        .map(|(i, share)| {
+            let bytes = encode_share(&keys[i], &reasoned.relations, share);
+            cache.put_plan(&keys[i], &bytes);
+            share.iter().filter(|(r, _)| Some(*r) == wall_slot).count()
+        })
+        .collect();
+    counts.rejected = (0..walls.len())
+        .filter(|&i| rejected[i])
+        .map(|i| walls[i])
+        .sum();
+    reasoned.relations.remove(REACH);
+    counts.computed = reasoned.get("wall").len();
+    Ok((reasoned, counts))
 }
 
 /// A unit of reasoning.
