@@ -47,19 +47,21 @@ impl Cache {
         &self.dir
     }
 
-    fn wall_path(&self, key: &str) -> PathBuf {
-        // Two-character fan-out keeps folders small on shared filesystems.
+    /// `DIR/<folder>/<first two characters of key>/<key>.<extension>`: the two-character
+    /// fan-out keeps folders small on shared filesystems.
+    fn entry_path(&self, folder: &str, key: &str, extension: &str) -> PathBuf {
         self.dir
-            .join(WALLS)
+            .join(folder)
             .join(&key[..2.min(key.len())])
-            .join(format!("{key}.json"))
+            .join(format!("{key}.{extension}"))
+    }
+
+    fn wall_path(&self, key: &str) -> PathBuf {
+        self.entry_path(WALLS, key, "json")
     }
 
     fn plan_path(&self, key: &str) -> PathBuf {
-        self.dir
-            .join(PLANS)
-            .join(&key[..2.min(key.len())])
-            .join(format!("{key}.part"))
+        self.entry_path(PLANS, key, "part")
     }
 
     /// The bytes of a plan part's entry (the caller verifies them), None when absent.
@@ -221,6 +223,30 @@ struct EntryFile {
     kind: Kind,
 }
 
+/// The files of a fan-out folder (`<folder>/<2 characters>/<file>`) that `kind_of` names.
+fn fan_out_files(
+    folder: &Path,
+    files: &mut Vec<EntryFile>,
+    kind_of: impl Fn(&str) -> Option<Kind>,
+) {
+    let Ok(subdirs) = std::fs::read_dir(folder) else {
+        return;
+    };
+    for sub in subdirs.flatten() {
+        let Ok(entries) = std::fs::read_dir(sub.path()) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            if let Some(kind) = kind_of(&e.file_name().to_string_lossy()) {
+                files.push(EntryFile {
+                    path: e.path(),
+                    kind,
+                });
+            }
+        }
+    }
+}
+
 /// The entry files (and left-over temporary files) of a cache folder, sorted.
 fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
     let mut files = Vec::new();
@@ -241,45 +267,20 @@ fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
             });
         }
     }
-    if let Ok(subdirs) = std::fs::read_dir(dir.join(WALLS)) {
-        for sub in subdirs.flatten() {
-            let Ok(entries) = std::fs::read_dir(sub.path()) else {
-                continue;
-            };
-            for e in entries.flatten() {
-                let name = e.file_name().to_string_lossy().into_owned();
-                let kind = if name.ends_with(".trace") {
-                    Kind::Trace
-                } else if name.ends_with(".json")
-                    || (name.starts_with('.') && name.ends_with(".tmp"))
-                {
-                    Kind::Wall
-                } else {
-                    continue;
-                };
-                files.push(EntryFile {
-                    path: e.path(),
-                    kind,
-                });
-            }
+    // A temporary file of the atomic writer is `.<target name>.<random>.tmp`.
+    let leftover = |name: &str| name.starts_with('.') && name.ends_with(".tmp");
+    fan_out_files(&dir.join(WALLS), &mut files, |name| {
+        if name.ends_with(".trace") {
+            Some(Kind::Trace)
+        } else if name.ends_with(".json") || leftover(name) {
+            Some(Kind::Wall)
+        } else {
+            None
         }
-    }
-    if let Ok(subdirs) = std::fs::read_dir(dir.join(PLANS)) {
-        for sub in subdirs.flatten() {
-            let Ok(entries) = std::fs::read_dir(sub.path()) else {
-                continue;
-            };
-            for e in entries.flatten() {
-                let name = e.file_name().to_string_lossy().into_owned();
-                if name.ends_with(".part") || (name.starts_with('.') && name.ends_with(".tmp")) {
-                    files.push(EntryFile {
-                        path: e.path(),
-                        kind: Kind::Plan,
-                    });
-                }
-            }
-        }
-    }
+    });
+    fan_out_files(&dir.join(PLANS), &mut files, |name| {
+        (name.ends_with(".part") || leftover(name)).then_some(Kind::Plan)
+    });
     files.sort_by(|a, b| a.path.cmp(&b.path));
     Ok(files)
 }
