@@ -3,12 +3,17 @@
 //! keys and rule lines; or which rule could have derived a tuple and which
 //! condition failed.
 
-use super::check::{ReasoningInputs, load_inputs, rule_base};
+use super::check::{ReasoningInputs, load_inputs, load_model_facts, rule_base};
 use super::{CmdResult, Failure, print_stdout};
+use framewright::frame::containers::{containers_of, restrict_to_containers};
+use framewright::frame::placement::add_placement_facts;
 use framewright::user_rules::render::{render_why, render_why_not};
 use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
-use framewright::user_rules::why::{Context, WhyError, element_walls, why, why_not};
+use framewright::user_rules::why::{
+    Context, WhyError, element_walls, resolve_element, why, why_not,
+};
 use serde::Serialize;
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -121,7 +126,13 @@ fn failure(e: WhyError) -> Failure {
 pub fn run_why(args: WhyArgs) -> CmdResult {
     let c = &args.common;
     let base = rule_base(&c.inputs.rules_dir);
-    let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
+    let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
+    // Only the element's containers matter (see `frame::containers`): the placement search
+    // and the rules run over them alone.
+    let pieces = resolve_element(&model, &args.id).map_err(failure)?;
+    let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
+    let mut facts = restrict_to_containers(&facts, &containers_of(&facts, &ids));
+    add_placement_facts(&mut facts, &cell, &base)?;
     let simulated = simulate_walls(
         c,
         &args.model,

@@ -3,6 +3,7 @@
 //! runs the same rules for `--rules-dir`, user rules and provenance.
 
 pub mod cell_facts;
+pub mod containers;
 pub mod facts;
 pub mod limits;
 pub mod partition;

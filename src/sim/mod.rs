@@ -17,11 +17,13 @@ pub use motion::{JointMove, LinearMove, Profile};
 pub use record::WallRecord;
 
 use crate::cell::Cell;
+use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::plan::Plan;
 use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, cell_facts, model_facts, reason};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
 use crate::world::{Scene, WorldError};
+use std::collections::BTreeSet;
 
 /// How to simulate.
 #[derive(Debug, Clone)]
@@ -146,13 +148,73 @@ pub fn simulate_with_progress(
     options: &SimOptions,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<Simulation, SimError> {
+    let mut facts = model_facts(model, &ContactOptions::default());
+    facts.extend(cell_facts(cell));
+    let (scene, plan, records) = run_walls(model, model_name, cell, options, &mut facts, progress)?;
+    let mut sim_facts = Facts::default();
+    for r in &records {
+        sim_facts.extend(r.facts());
+    }
+    facts.extend(sim_facts.clone());
+    let reasoned = reason(&facts, &options.engine, false)?;
+    Ok(Simulation {
+        scene,
+        plan,
+        records,
+        facts: sim_facts,
+        reasoned,
+    })
+}
+
+/// The `rules/sim.dl` facts of the walls `options.walls` names, without reasoning over
+/// them. Walls named by their key pieces (as `wall_of` names them) are planned from their
+/// spatial containers' facts alone (no rule relates pieces of two containers, see
+/// `frame::containers`), so one wall of a big model costs its storey's reasoning, not the
+/// model's; the facts are those `simulate` gives for the wall.
+pub fn simulate_wall_facts(
+    model: &Model,
+    cell: &Cell,
+    options: &SimOptions,
+) -> Result<Facts, SimError> {
+    let mut facts = model_facts(model, &ContactOptions::default());
+    facts.extend(cell_facts(cell));
+    let each_container: Option<BTreeSet<String>> = options
+        .walls
+        .iter()
+        .map(|w| {
+            let one = containers_of(&facts, &BTreeSet::from([w.as_str()]));
+            (!one.is_empty()).then_some(one)
+        })
+        .try_fold(BTreeSet::new(), |mut all, one| {
+            all.extend(one?);
+            Some(all)
+        });
+    if let Some(containers) = each_container.filter(|c| !c.is_empty()) {
+        facts = restrict_to_containers(&facts, &containers);
+    }
+    let (_, _, records) = run_walls(model, "model", cell, options, &mut facts, &|_, _, _| {})?;
+    let mut sim_facts = Facts::default();
+    for r in &records {
+        sim_facts.extend(r.facts());
+    }
+    Ok(sim_facts)
+}
+
+/// Places and reasons `facts` (a model's and a cell's), then runs the selected walls in
+/// parallel: the scene, the plan and one record per wall, in wall order.
+fn run_walls(
+    model: &Model,
+    model_name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    facts: &mut Facts,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<(Scene, Plan, Vec<WallRecord>), SimError> {
     use rayon::prelude::*;
     check_options(options)?;
     let limit = max_sim_seconds_per_wall()?;
-    let mut facts = model_facts(model, &ContactOptions::default());
-    facts.extend(cell_facts(cell));
-    crate::frame::placement::add_placement_facts(&mut facts, cell, &options.engine)?;
-    let planned = reason(&facts, &options.engine, false)?;
+    crate::frame::placement::add_placement_facts(facts, cell, &options.engine)?;
+    let planned = reason(facts, &options.engine, false)?;
     let scene = Scene::build(model_name, model, cell, &planned)?;
     let plan = Plan::from_reasoned(model, &planned);
     let selected = select_walls(&plan, &options.walls)?;
@@ -180,20 +242,7 @@ pub fn simulate_with_progress(
             }))
         })
         .collect::<Result<_, _>>()?;
-
-    let mut sim_facts = Facts::default();
-    for r in &records {
-        sim_facts.extend(r.facts());
-    }
-    facts.extend(sim_facts.clone());
-    let reasoned = reason(&facts, &options.engine, false)?;
-    Ok(Simulation {
-        scene,
-        plan,
-        records,
-        facts: sim_facts,
-        reasoned,
-    })
+    Ok((scene, plan, records))
 }
 
 /// The option checks of `simulate`: a time step in (0, 0.05] s, a speed fraction in (0, 1].

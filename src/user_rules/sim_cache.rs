@@ -11,7 +11,7 @@ use crate::frame::{Facts, RuleEngine};
 use crate::ifc::Model;
 use crate::logic::compiled::BUILTIN_SOURCES;
 use crate::logic::{Origin, Value};
-use crate::sim::{SimError, SimOptions, simulate};
+use crate::sim::{SimError, SimOptions, simulate_wall_facts};
 use serde::{Deserialize, Serialize};
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
@@ -73,7 +73,7 @@ pub fn wall_sim_facts(
         engine: engine.clone(),
         ..SimOptions::default()
     };
-    let facts = simulate(model, cell, &options)?.facts;
+    let facts = simulate_wall_facts(model, cell, &options)?;
     if let Some(f) = file {
         // A cache that cannot be written only costs the next run a simulation.
         let _ = write_entry(&f, &key, &facts);

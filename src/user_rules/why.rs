@@ -6,12 +6,13 @@
 //! events.
 
 use super::{UserRulesError, full_program};
+use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::{Facts, RuleEngine};
 use crate::ifc::{Model, Piece};
 use crate::logic::provenance::{Explanation, How, Premise, WhyNot, parse_query};
 use crate::logic::{Engine, LogicError, Options, Origin, Value};
 use serde::Serialize;
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -131,49 +132,6 @@ fn unknown_element(model: &Model, id: &str) -> String {
     format!(
         "no piece of the model has the id `{id}` ({nearby}); an ID is a piece id, an IFC GlobalId or an entity `#id`; `framewright plan MODEL.ifc --json` lists every member with its id and entity"
     )
-}
-
-/// The facts of the given containers only: tuples about a piece of another
-/// container are left out (contacts need both pieces inside); facts about no
-/// piece (the cell) are kept.
-pub fn restrict_to_containers(facts: &Facts, containers: &BTreeSet<String>) -> Facts {
-    let container_of: BTreeMap<&str, &str> = facts
-        .tuples
-        .get("piece_container")
-        .into_iter()
-        .flatten()
-        .filter_map(|(t, _)| Some((t[0].as_symbol()?, t[1].as_symbol()?)))
-        .collect();
-    let inside = |v: Option<&Value>| match v
-        .and_then(Value::as_symbol)
-        .and_then(|s| container_of.get(s))
-    {
-        Some(c) => containers.contains(*c),
-        None => true,
-    };
-    let mut out = Facts::default();
-    for (name, tuples) in &facts.tuples {
-        for (t, origin) in tuples {
-            let keep = inside(t.first()) && (*name != "contact" || inside(t.get(1)));
-            if keep {
-                out.add(name, t.clone(), origin.clone());
-            }
-        }
-    }
-    out
-}
-
-/// The containers of the pieces named by symbols of `values` (none when no
-/// value names a piece).
-fn containers_of(facts: &Facts, ids: &BTreeSet<&str>) -> BTreeSet<String> {
-    facts
-        .tuples
-        .get("piece_container")
-        .into_iter()
-        .flatten()
-        .filter(|(t, _)| t[0].as_symbol().is_some_and(|p| ids.contains(p)))
-        .filter_map(|(t, _)| t[1].as_symbol().map(str::to_string))
-        .collect()
 }
 
 /// The walls (keys, as in `wall_of`) of the pieces an ID names, from the
