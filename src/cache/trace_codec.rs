@@ -186,7 +186,6 @@ fn pose(b: &[u64; 7]) -> Isometry3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::BTreeMap;
 
     fn sample() -> PoseTrace {
         let mut t = PoseTrace::default();
@@ -195,10 +194,9 @@ mod tests {
             nalgebra::Vector3::new(0.3, -0.2, 0.1),
         );
         let b = Isometry3::translation(1.0, 2.0, -0.0);
-        let one = |p| BTreeMap::from([("p1".to_string(), p)]);
-        t.sample(0.0, &[0.1, 0.2, 0.3, 0.4, 0.5, 0.6], a, one(a));
-        t.sample(0.05, &[0.2, 0.2, 0.3, 0.4, 0.5, 0.7], b, one(b));
-        t.sample(0.1, &[0.3, 0.2, 0.3, 0.4, 0.5, 0.8], a, BTreeMap::new());
+        t.sample(0.0, &[0.1, 0.2, 0.3, 0.4, 0.5, 0.6], a, &[("p1", a)]);
+        t.sample(0.05, &[0.2, 0.2, 0.3, 0.4, 0.5, 0.7], b, &[("p1", b)]);
+        t.sample(0.1, &[0.3, 0.2, 0.3, 0.4, 0.5, 0.8], a, &[]);
         t.finish();
         t
     }

@@ -128,7 +128,9 @@ pub struct Physics {
     /// moves at its belt's speed, touching nothing). Settling is judged from the last one.
     disturbances: u64,
     /// Pieces riding a running belt as kinematic bodies (see `start_ride`).
-    riding: BTreeSet<String>,
+    riding: BTreeMap<String, LumberBody>,
+    /// Riders of the stopped belts left kinematic at rest (see `set_belts`); also in `riding`.
+    parked: BTreeSet<String>,
     /// Where `advance_rides` last put each rider, unrounded.
     ride_exact: HashMap<RigidBodyHandle, Vector3<f64>>,
 }
@@ -141,6 +143,8 @@ pub struct Clearance {
     pub any: f64,
     /// To lumber that can move (dynamic bodies).
     pub loose: f64,
+    /// To lumber parked on the stopped belts (see `set_belts`).
+    pub parked: f64,
 }
 
 impl Physics {
@@ -386,7 +390,8 @@ impl Physics {
             cell: cell.clone(),
             generation: 0,
             disturbances: 0,
-            riding: BTreeSet::new(),
+            riding: BTreeMap::new(),
+            parked: BTreeSet::new(),
             ride_exact: HashMap::new(),
         }
     }
@@ -440,7 +445,7 @@ impl Physics {
         let Some(b) = self.lumber.get(id).copied() else {
             return;
         };
-        if !self.riding.insert(id.to_string()) {
+        if self.riding.insert(id.to_string(), b).is_some() {
             return;
         }
         self.changed(false);
@@ -458,10 +463,8 @@ impl Physics {
 
     /// A riding piece is a dynamic body again, moving as it rode.
     pub fn end_ride(&mut self, id: &str) {
-        if !self.riding.remove(id) {
-            return;
-        }
-        let Some(b) = self.lumber.get(id).copied() else {
+        self.parked.remove(id);
+        let Some(b) = self.riding.remove(id) else {
             return;
         };
         self.ride_exact.remove(&b.body);
@@ -477,14 +480,13 @@ impl Physics {
 
     /// Whether a piece rides its belt (see `start_ride`).
     pub fn is_riding(&self, id: &str) -> bool {
-        self.riding.contains(id)
+        self.riding.contains_key(id)
     }
 
     /// The fastest riding piece's speed (m/s), 0 with none riding.
     pub fn ride_speed(&self) -> f64 {
         self.riding
-            .iter()
-            .filter_map(|id| self.lumber.get(id))
+            .values()
             .map(|b| f64::from(self.world.bodies[b.body].linvel().length()))
             .fold(0.0, f64::max)
     }
@@ -494,10 +496,10 @@ impl Physics {
     /// phase, contacts) see the new positions at the next step or `detect`; `clearance`
     /// measures riders where they are.
     pub fn advance_rides(&mut self, dt: f64) {
-        for id in &self.riding {
-            let Some(b) = self.lumber.get(id) else {
-                continue;
-            };
+        if !self.belts.running {
+            return; // parked pieces stay put
+        }
+        for b in self.riding.values() {
             let body = &mut self.world.bodies[b.body];
             // Summed in f64 from where the last advance left it (unless a solver step moved
             // it since), then rounded: adding the same small step in f32 rounds the same way
@@ -524,6 +526,7 @@ impl Physics {
     /// Takes a piece out of the world (an operator lifts it off the belt).
     pub fn remove_lumber(&mut self, id: &str) {
         self.riding.remove(id);
+        self.parked.remove(id);
         self.changed(true);
         if let Some(b) = self.lumber.remove(id) {
             self.ride_exact.remove(&b.body);
@@ -609,6 +612,7 @@ impl Physics {
 
     /// Holds a piece rigidly in the gripper: it becomes position-driven (it follows the tool).
     pub fn attach(&mut self, id: &str) {
+        self.end_ride(id);
         self.changed(true);
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::KinematicPositionBased, true);
@@ -662,25 +666,53 @@ impl Physics {
         self.world.insert_impulse_joint(a.body, b.body, joint);
     }
 
-    /// Starts or stops both belts; a started belt wakes the lumber on it.
-    pub fn set_belts(&mut self, running: bool) {
+    /// Starts or stops both belts; a started belt wakes the lumber on it. Stopping them ends
+    /// every ride: the riders become dynamic bodies at rest where they are, or, with `park`,
+    /// stay kinematic bodies at rest (they touch nothing, so the solver has nothing to do for
+    /// them; see `unpark`). Parked pieces become dynamic when the belts start again.
+    pub fn set_belts(&mut self, running: bool, park: bool) {
         self.changed(true);
         if !running {
-            let riding: Vec<String> = self.riding.iter().cloned().collect();
+            let riding: Vec<String> = self.riding.keys().cloned().collect();
             for id in riding {
-                self.end_ride(&id);
+                if park {
+                    self.park(&id);
+                } else {
+                    self.end_ride(&id);
+                }
                 if let Some(b) = self.lumber.get(&id) {
                     self.world.bodies[b.body].set_linvel(Vector::ZERO, true);
                 }
             }
         }
         if running && !self.belts.running {
+            self.unpark();
             let bodies: Vec<RigidBodyHandle> = self.lumber.values().map(|b| b.body).collect();
             for b in bodies {
                 self.world.wake_up(b, true);
             }
         }
         self.belts.running = running;
+    }
+
+    /// A rider of a stopping belt stays a kinematic body, at rest and still without contacts.
+    fn park(&mut self, id: &str) {
+        if let Some(b) = self.lumber.get(id) {
+            self.ride_exact.remove(&b.body);
+        }
+        self.parked.insert(id.to_string());
+    }
+
+    /// Every parked piece becomes a dynamic body at rest where it lies, as stopping the belts
+    /// without parking leaves it: before the belts start, or before the robot comes near one.
+    pub fn unpark(&mut self) {
+        let parked: Vec<String> = std::mem::take(&mut self.parked).into_iter().collect();
+        for id in parked {
+            self.end_ride(&id);
+            if let Some(b) = self.lumber.get(&id) {
+                self.world.bodies[b.body].set_linvel(Vector::ZERO, true);
+            }
+        }
     }
 
     /// One physics step.
@@ -851,20 +883,21 @@ impl Physics {
         }
         // Riders are measured apart, where they are now: between steps the broad phase holds
         // them where the last step left them.
-        let riders: Vec<LumberBody> = self
+        let riders: Vec<(&str, LumberBody)> = self
             .riding
             .iter()
-            .filter_map(|id| self.lumber.get(id).copied())
+            .map(|(id, b)| (id.as_str(), *b))
             .collect();
         let predicate = |_: ColliderHandle, c: &Collider| {
             !c.is_sensor()
                 && !c
                     .parent()
-                    .is_some_and(|b| own.contains(&b) || riders.iter().any(|r| r.body == b))
+                    .is_some_and(|b| own.contains(&b) || riders.iter().any(|(_, r)| r.body == b))
         };
         let mut found = Clearance {
             any: reach,
             loose: reach,
+            parked: reach,
         };
         for (c, pose) in self.robot_shapes_at(q, held) {
             let collider = &self.world.colliders[c];
@@ -893,7 +926,8 @@ impl Physics {
                 }
             }
             // A rider moves on its own: it counts as loose.
-            for r in &riders {
+            let reach_box = shape.compute_aabb(&pose).loosened(reach as f32);
+            for (id, r) in &riders {
                 if !collider
                     .collision_groups()
                     .test(self.world.colliders[r.collider].collision_groups())
@@ -903,10 +937,17 @@ impl Physics {
                 let other = &self.world.colliders[r.collider];
                 let at = *self.world.bodies[r.body].position()
                     * *other.position_wrt_parent().unwrap_or(&Pose::IDENTITY);
+                // Farther than `reach` changes nothing (distances are capped at it).
+                if !reach_box.intersects(&other.shape().compute_aabb(&at)) {
+                    continue;
+                }
                 let d = rapier3d::parry::query::distance(&pose, shape, &at, other.shape())
                     .map_or(0.0, |d| f64::from(d.distance).min(reach));
                 found.any = found.any.min(d);
                 found.loose = found.loose.min(d);
+                if self.parked.contains(*id) {
+                    found.parked = found.parked.min(d);
+                }
             }
         }
         found
@@ -971,9 +1012,17 @@ impl Physics {
 
     /// Current pose of every piece in the world.
     pub fn lumber_poses(&self) -> BTreeMap<String, Isometry3<f64>> {
+        self.lumber_poses_in_order()
+            .into_iter()
+            .map(|(id, pose)| (id.to_string(), pose))
+            .collect()
+    }
+
+    /// Current pose of every piece in the world, in id order, without copying the ids.
+    pub fn lumber_poses_in_order(&self) -> Vec<(&str, Isometry3<f64>)> {
         self.lumber
             .iter()
-            .map(|(id, b)| (id.clone(), to_iso(self.world.bodies[b.body].position())))
+            .map(|(id, b)| (id.as_str(), to_iso(self.world.bodies[b.body].position())))
             .collect()
     }
 }
@@ -1053,7 +1102,7 @@ mod tests {
         let mut phys = Physics::new(&cell, &cell.robot.home(), dt);
         let (piece, pose) = piece_on_deck(&cell);
         phys.add_lumber(&piece, &pose);
-        phys.set_belts(true);
+        phys.set_belts(true, false);
         for _ in 0..240 {
             phys.step();
         }
@@ -1079,9 +1128,69 @@ mod tests {
         let body = phys.lumber["p"].body;
         assert!(phys.world.bodies[body].is_kinematic());
         // Stopping the belts ends the ride: a dynamic body at rest.
-        phys.set_belts(false);
+        phys.set_belts(false, false);
         assert!(phys.world.bodies[body].is_dynamic());
         assert!(phys.lumber_speed("p").expect("piece").0 < 1e-9);
+    }
+
+    #[test]
+    fn a_parked_rider_stays_put_without_the_solver_and_is_dynamic_when_the_belts_start() {
+        let cell = Cell::load("study-abb").expect("cell");
+        let dt = 1.0 / 240.0;
+        let mut phys = Physics::new(&cell, &cell.robot.home(), dt);
+        let (piece, pose) = piece_on_deck(&cell);
+        phys.add_lumber(&piece, &pose);
+        phys.set_belts(true, false);
+        let velocity = cell.conveyor1.direction() * cell.conveyor1.speed;
+        phys.start_ride("p", &velocity);
+        for _ in 0..24 {
+            phys.step();
+            phys.advance_rides(dt);
+        }
+        phys.set_belts(false, true);
+        let body = phys.lumber["p"].body;
+        let parked_at = phys.lumber_pose("p").expect("piece");
+        // Parked: kinematic, at rest, not counted as lumber the solver must watch.
+        assert!(phys.world.bodies[body].is_kinematic());
+        assert!(phys.lumber_calm(1e-9, 1e-9));
+        for _ in 0..240 {
+            phys.step();
+            phys.advance_rides(dt);
+        }
+        assert_eq!(phys.lumber_pose("p").expect("piece"), parked_at);
+        // The robot's clearance sees it as parked lumber.
+        let clear = phys.clearance(&cell.robot.home(), None, 100.0);
+        assert!(clear.parked < 100.0 && clear.parked >= clear.loose);
+        // Starting the belts leaves it as stopping them without parking does: dynamic, at rest.
+        phys.set_belts(true, false);
+        assert!(phys.world.bodies[body].is_dynamic());
+        assert!(!phys.is_riding("p"));
+        assert!(phys.lumber_speed("p").expect("piece").0 < 1e-9);
+        assert_eq!(phys.lumber_pose("p").expect("piece"), parked_at);
+    }
+
+    #[test]
+    fn unparking_makes_parked_lumber_dynamic_at_rest() {
+        let cell = Cell::load("study-abb").expect("cell");
+        let mut phys = Physics::new(&cell, &cell.robot.home(), 1.0 / 240.0);
+        let (piece, pose) = piece_on_deck(&cell);
+        phys.add_lumber(&piece, &pose);
+        phys.set_belts(true, false);
+        phys.start_ride("p", &(cell.conveyor1.direction() * cell.conveyor1.speed));
+        phys.set_belts(false, true);
+        let generation = phys.generation();
+        phys.unpark();
+        let body = phys.lumber["p"].body;
+        assert!(phys.world.bodies[body].is_dynamic());
+        assert!(!phys.is_riding("p"));
+        assert!(
+            phys.generation() > generation,
+            "unparking changes the world"
+        );
+        assert_eq!(
+            phys.clearance(&cell.robot.home(), None, 100.0).parked,
+            100.0
+        );
     }
 
     #[test]
@@ -1093,7 +1202,7 @@ mod tests {
             let mut phys = Physics::new(&cell, &cell.robot.home(), dt);
             let (piece, pose) = piece_on_deck(&cell);
             phys.add_lumber(&piece, &pose);
-            phys.set_belts(true);
+            phys.set_belts(true, false);
             phys.start_ride("p", &velocity);
             for _ in 0..480 {
                 if advance {

@@ -143,37 +143,41 @@ impl PoseTrace {
             .is_none_or(|last| t >= last + TRACE_PERIOD - 1e-9)
     }
 
-    /// Records one sample: joint values, tool0 and every lumber body present.
+    /// Records one sample: joint values, tool0 and every lumber body present, in id order.
     pub fn sample(
         &mut self,
         t: f64,
         q: &[f64],
         tool: Isometry3<f64>,
-        lumber: BTreeMap<String, Isometry3<f64>>,
+        lumber: &[(&str, Isometry3<f64>)],
     ) {
+        debug_assert!(lumber.windows(2).all(|w| w[0].0 < w[1].0), "in id order");
         self.times.push(t);
         self.joints.push(q.to_vec());
         self.tool.push(tool);
+        // Tracks and present pieces are both in id order: one walk pairs them, finds the
+        // pieces gone and the new ones, without a lookup per piece.
+        let mut present = lumber.iter().peekable();
+        let mut new = Vec::new();
         for (id, track) in &mut self.lumber {
-            if track.gone.is_none() && !lumber.contains_key(id) {
-                track.flush();
-                track.gone = Some(t);
+            while let Some(&(p, pose)) = present.next_if(|(p, _)| *p < id.as_str()) {
+                new.push((p, pose));
+            }
+            match present.next_if(|(p, _)| *p == id.as_str()) {
+                Some(&(_, pose)) => track.observe(t, pose),
+                None if track.gone.is_none() => {
+                    track.flush();
+                    track.gone = Some(t);
+                }
+                None => {}
             }
         }
-        for (id, pose) in lumber {
-            let track = self.lumber.entry(id).or_default();
-            let Some(&(_, last)) = track.keys.last() else {
-                track.keys.push((t, pose));
-                continue;
-            };
-            let moved = (pose.translation.vector - last.translation.vector).norm() > REST_MOVE
-                || pose.rotation.angle_to(&last.rotation) > REST_MOVE;
-            if moved {
-                track.flush();
-                track.keys.push((t, pose));
-            } else {
-                track.held = Some((t, pose));
-            }
+        new.extend(present.copied());
+        for (id, pose) in new {
+            self.lumber
+                .entry(id.to_string())
+                .or_default()
+                .observe(t, pose);
         }
     }
 
@@ -186,6 +190,23 @@ impl PoseTrace {
 }
 
 impl LumberTrack {
+    /// A sample of the piece at `t`: a key where it moved since the last one, else the rest
+    /// pose held back until it moves or the trace ends.
+    fn observe(&mut self, t: f64, pose: Isometry3<f64>) {
+        let Some(&(_, last)) = self.keys.last() else {
+            self.keys.push((t, pose));
+            return;
+        };
+        let moved = (pose.translation.vector - last.translation.vector).norm() > REST_MOVE
+            || pose.rotation.angle_to(&last.rotation) > REST_MOVE;
+        if moved {
+            self.flush();
+            self.keys.push((t, pose));
+        } else {
+            self.held = Some((t, pose));
+        }
+    }
+
     fn flush(&mut self) {
         if let Some(key) = self.held.take() {
             self.keys.push(key);
@@ -374,5 +395,43 @@ impl WallRecord {
             );
         }
         facts
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sample_pairs_pieces_with_their_tracks_and_notes_new_and_gone_ones() {
+        let at = |x: f64| Isometry3::translation(x, 0.0, 0.0);
+        let mut trace = PoseTrace::default();
+        trace.sample(0.0, &[0.0], at(0.0), &[("b", at(1.0)), ("d", at(2.0))]);
+        // "a" and "c" appear before and between the tracked ids, "b" moves, "d" is gone.
+        trace.sample(
+            0.05,
+            &[0.0],
+            at(0.0),
+            &[("a", at(3.0)), ("b", at(1.5)), ("c", at(4.0))],
+        );
+        // "b" rests, "c" leaves.
+        trace.sample(0.1, &[0.0], at(0.0), &[("a", at(3.0)), ("b", at(1.5))]);
+        trace.finish();
+        let keys = |id: &str| -> Vec<(f64, f64)> {
+            trace.lumber[id]
+                .keys
+                .iter()
+                .map(|(t, p)| (*t, p.translation.x))
+                .collect()
+        };
+        assert_eq!(keys("a"), vec![(0.05, 3.0), (0.1, 3.0)]);
+        assert_eq!(keys("b"), vec![(0.0, 1.0), (0.05, 1.5), (0.1, 1.5)]);
+        assert_eq!(keys("c"), vec![(0.05, 4.0)]);
+        assert_eq!(keys("d"), vec![(0.0, 2.0)]);
+        let gone = |id: &str| trace.lumber[id].gone;
+        assert_eq!(
+            [gone("a"), gone("b"), gone("c"), gone("d")],
+            [None, None, Some(0.1), Some(0.05)]
+        );
     }
 }

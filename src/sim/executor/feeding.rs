@@ -241,7 +241,9 @@ impl<'a> WallRun<'a> {
             .filter(|id| Some(id) != held.as_ref() && self.on_belts.contains(id))
             .collect();
         if let Some(id) = arrived.first() {
-            self.phys.set_belts(false);
+            // Event-driven runs park the riders: they touch nothing, the solver need not hold them.
+            let park = self.options.stepping == crate::sim::Stepping::Events;
+            self.phys.set_belts(false, park);
             for belt in ["conveyor1", "conveyor2"] {
                 self.record.belt_events.push(BeltEvent {
                     t: self.t,
@@ -257,7 +259,7 @@ impl<'a> WallRun<'a> {
         if self.phys.belts.running {
             return;
         }
-        self.phys.set_belts(true);
+        self.phys.set_belts(true, false);
         for belt in ["conveyor1", "conveyor2"] {
             self.record.belt_events.push(BeltEvent {
                 t: self.t,

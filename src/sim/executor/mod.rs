@@ -211,11 +211,7 @@ impl<'a> WallRun<'a> {
         self.phys.step();
         self.t += self.options.dt;
         self.record.steps += 1;
-        if self.record.trace.due(self.t) {
-            let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
-            let lumber = self.phys.lumber_poses();
-            self.record.trace.sample(self.t, &self.q, tool, lumber);
-        }
+        self.sample_trace();
         self.feed();
         self.watch_sensor();
         self.watch_contacts();

@@ -45,6 +45,9 @@ pub(super) struct Events {
     prev_q: Vec<f64>,
     /// The last clearance measurement, while it holds.
     anchor: Option<Anchor>,
+    /// `all_on_belts_ride`'s last answer and the (world change count, pieces on the belts)
+    /// it was found at.
+    all_ride: Option<((u64, usize), bool)>,
 }
 
 #[derive(Debug, Clone)]
@@ -70,6 +73,7 @@ impl Events {
             disturbances: u64::MAX,
             prev_q: q.to_vec(),
             anchor: None,
+            all_ride: None,
         }
     }
 }
@@ -90,10 +94,9 @@ impl<'a> WallRun<'a> {
         let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
         let generation = self.phys.generation();
         let base = self.phys.robot_base();
-        let ride_speed = self.phys.ride_speed();
         let within = self.events.anchor.as_ref().is_some_and(|a| {
             // The robot and a rider may close the gap from both sides.
-            let ridden = ride_speed * (self.t - a.t + self.options.dt);
+            let ridden = self.phys.ride_speed() * (self.t - a.t + self.options.dt);
             let moved: f64 =
                 a.q.iter()
                     .zip(&at)
@@ -110,6 +113,10 @@ impl<'a> WallRun<'a> {
             let clear = self.phys.clearance(&at, held_ref, CLEARANCE_REACH);
             if clear.loose < LOOSE_MARGIN {
                 self.events.anchor = None;
+                if clear.parked < LOOSE_MARGIN {
+                    // The robot may push parked lumber: it is dynamic again, as unparked.
+                    self.phys.unpark();
+                }
                 self.solver_tick();
                 return;
             }
@@ -133,10 +140,25 @@ impl<'a> WallRun<'a> {
     /// lumber on running belts all rides (a rider moves at its belt's speed, without
     /// contacts), and every other piece at rest for CALM_STEPS solver steps since the last
     /// change.
-    fn world_quiet(&self) -> bool {
-        (!self.phys.belts.running || self.on_belts.iter().all(|id| self.phys.is_riding(id)))
+    fn world_quiet(&mut self) -> bool {
+        (!self.phys.belts.running || self.all_on_belts_ride())
             && self.events.disturbances == self.phys.disturbances()
             && self.events.calm_steps >= CALM_STEPS
+    }
+
+    /// Whether every piece on the belts rides them. Rides start and end, and pieces come onto
+    /// and leave the belts, only with a change to the world: the answer holds while the
+    /// world's change count and the count of pieces on the belts stay.
+    fn all_on_belts_ride(&mut self) -> bool {
+        let state = (self.phys.generation(), self.on_belts.len());
+        if let Some((seen, answer)) = self.events.all_ride
+            && seen == state
+        {
+            return answer;
+        }
+        let answer = self.on_belts.iter().all(|id| self.phys.is_riding(id));
+        self.events.all_ride = Some((state, answer));
+        answer
     }
 
     /// A step with the solver (the robot's bodies stand where the last tick left them).
@@ -183,13 +205,13 @@ impl<'a> WallRun<'a> {
         self.events.prev_q.clone_from(&self.q);
     }
 
-    /// A trace sample, if one is due (as `step` takes it).
-    fn sample_trace(&mut self) {
+    /// A trace sample, if one is due.
+    pub(super) fn sample_trace(&mut self) {
         if !self.record.trace.due(self.t) {
             return;
         }
         let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
-        let lumber = self.phys.lumber_poses();
-        self.record.trace.sample(self.t, &self.q, tool, lumber);
+        let lumber = self.phys.lumber_poses_in_order();
+        self.record.trace.sample(self.t, &self.q, tool, &lumber);
     }
 }
