@@ -131,8 +131,18 @@ pub struct Physics {
     riding: BTreeMap<String, LumberBody>,
     /// Riders of the stopped belts left kinematic at rest (see `set_belts`); also in `riding`.
     parked: BTreeSet<String>,
+    /// The joints and held piece `place_robot` last put the robot's bodies at, until
+    /// anything else may have moved them (a step, a drive, a carry, a change to the world).
+    placed: Option<RobotPlacement>,
     /// Where `advance_rides` last put each rider, unrounded.
     ride_exact: HashMap<RigidBodyHandle, Vector3<f64>>,
+}
+
+/// Joint values and the held piece (id, pose in tool0) the robot's bodies were placed at.
+#[derive(Debug, Clone)]
+struct RobotPlacement {
+    q: Vec<f64>,
+    held: Option<(String, Isometry3<f64>)>,
 }
 
 /// How far the robot, its tool and a held piece are from the rest of the world (m), each
@@ -392,6 +402,7 @@ impl Physics {
             disturbances: 0,
             riding: BTreeMap::new(),
             parked: BTreeSet::new(),
+            placed: None,
             ride_exact: HashMap::new(),
         }
     }
@@ -553,11 +564,13 @@ impl Physics {
     /// Moves the robot's base (its carriage on a linear track); the links follow at the
     /// next drive or placement.
     pub fn set_robot_base(&mut self, base: nalgebra::Isometry3<f64>) {
+        self.placed = None;
         self.cell.robot_base = base;
     }
 
     /// Moves the robot's bodies to joint values `q` by the end of the next step.
     pub fn drive_robot(&mut self, q: &[f64]) {
+        self.placed = None;
         let poses = self.cell.robot.fk_all(q);
         for &(i, body) in &self.links {
             let pose = to_pose(&(self.cell.robot_base * poses[i]));
@@ -638,7 +651,9 @@ impl Physics {
     /// The fixture holds a placed piece where it came to rest (a framing table's stops and
     /// clamps): it no longer moves, whatever touches it later.
     pub fn clamp(&mut self, id: &str) {
-        self.changed(true);
+        // Holding a piece still sets nothing moving: what rests on it keeps resting, and
+        // lumber that still moves keeps the solver stepping anyway.
+        self.changed(false);
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_body_type(RigidBodyType::Fixed, true);
         }
@@ -646,6 +661,7 @@ impl Physics {
 
     /// Moves a held piece with the tool by the end of the next step.
     pub fn carry(&mut self, id: &str, pose: &Isometry3<f64>) {
+        self.placed = None;
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_next_kinematic_position(to_pose(pose));
         }
@@ -717,6 +733,7 @@ impl Physics {
 
     /// One physics step.
     pub fn step(&mut self) {
+        self.placed = None;
         self.world.step_with_events(&self.belts, &());
     }
 
@@ -731,6 +748,7 @@ impl Physics {
     }
 
     fn changed(&mut self, disturbs: bool) {
+        self.placed = None;
         self.generation += 1;
         if disturbs {
             self.disturbances += 1;
@@ -740,6 +758,17 @@ impl Physics {
     /// Puts the robot's bodies (and the held piece, at `in_tool` in tool0) at joint values
     /// `q` at once, without a step: nothing is pushed and no velocity results.
     pub fn place_robot(&mut self, q: &[f64], held: Option<(&str, &Isometry3<f64>)>) {
+        // A robot standing still (waiting for a piece) is where the last placement left it.
+        let same = |p: &RobotPlacement| {
+            p.q.as_slice() == q && p.held.as_ref().map(|(id, g)| (id.as_str(), g)) == held
+        };
+        if self.placed.as_ref().is_some_and(same) {
+            return;
+        }
+        self.placed = Some(RobotPlacement {
+            q: q.to_vec(),
+            held: held.map(|(id, g)| (id.to_string(), *g)),
+        });
         let poses = self.cell.robot.fk_all(q);
         for &(i, body) in &self.links {
             let pose = to_pose(&(self.cell.robot_base * poses[i]));

@@ -89,27 +89,29 @@ impl<'a> WallRun<'a> {
             self.solver_tick();
             return;
         }
-        let at = self.events.prev_q.clone();
-        let held = self.held.clone();
-        let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
         let generation = self.phys.generation();
         let base = self.phys.robot_base();
+        let held_id = self.held.as_ref().map(|h| h.id.as_str());
         let within = self.events.anchor.as_ref().is_some_and(|a| {
             // The robot and a rider may close the gap from both sides.
             let ridden = self.phys.ride_speed() * (self.t - a.t + self.options.dt);
             let moved: f64 =
                 a.q.iter()
-                    .zip(&at)
+                    .zip(&self.events.prev_q)
                     .zip(&a.levers)
                     .map(|((from, to), lever)| (to - from).abs() * lever)
                     .sum();
             a.generation == generation
-                && a.held.as_deref() == held_ref.map(|h| h.0)
+                && a.held.as_deref() == held_id
                 && a.base == base
                 && moved + ridden < a.free
         });
         let mut touching = false;
         if !within {
+            // Measured where the robot's bodies stand (the previous tick's joints).
+            let at = self.events.prev_q.clone();
+            let held = self.held.clone();
+            let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
             let clear = self.phys.clearance(&at, held_ref, CLEARANCE_REACH);
             if clear.loose < LOOSE_MARGIN {
                 self.events.anchor = None;
@@ -125,7 +127,7 @@ impl<'a> WallRun<'a> {
             let corners = self.phys.robot_corners(&at, held_ref);
             self.events.anchor = Some(Anchor {
                 levers: self.phys.robot_levers(&at, &corners, free),
-                q: at.clone(),
+                q: at,
                 base,
                 free,
                 generation,
@@ -181,13 +183,11 @@ impl<'a> WallRun<'a> {
     /// something, its contacts. The robot's bodies end the tick where a fixed step leaves
     /// them (at `self.q`), for whatever the executor does next (grip, release, measure).
     fn quiet_tick(&mut self, touching: bool) {
-        let held = self.held.clone();
-        let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
+        let held_ref = self.held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
         // Contacts are recorded in operations other than waiting for a piece (as `step`).
         let watched = matches!(&self.current, Some((_, op, _)) if *op != "feed");
         if touching && watched {
-            let prev = self.events.prev_q.clone();
-            self.phys.place_robot(&prev, held_ref);
+            self.phys.place_robot(&self.events.prev_q, held_ref);
             self.phys.detect();
         }
         self.phys.place_robot(&self.q, held_ref);
