@@ -2,36 +2,30 @@
 //! storey's facts alone; its facts must be the ones a simulation of the whole model gives
 //! for that wall.
 
+mod common;
+
 use framewright::cell::Cell;
 use framewright::frame::{cell_facts, model_facts, reason};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::sim::{SimOptions, simulate, simulate_wall_facts};
 use std::path::Path;
-use std::process::Command;
 
 /// A generated block of two storeys (two spatial containers), walls grouped in IfcWall.
 fn two_storey_block(dir: &Path) -> Model {
-    let path = dir.join("block.ifc");
-    let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
-        .args([
-            "synth",
-            "block",
+    let path = common::synth_block(
+        dir,
+        &[
             "--blocks",
             "1",
             "--storeys",
             "2",
             "--grid",
             "1x1",
-        ])
-        .args(["--grouping", "wall", "--openings", "-o"])
-        .arg(&path)
-        .output()
-        .expect("framewright runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+            "--grouping",
+            "wall",
+            "--openings",
+        ],
     );
     Model::open(&path).expect("the generated model reads")
 }

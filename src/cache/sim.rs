@@ -6,7 +6,7 @@ use super::key::{build_id, wall_key};
 use super::store::{Cache, Lookup};
 use crate::cell::Cell;
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, Reasoned, cell_facts, model_facts, reason};
+use crate::frame::{Facts, cell_facts, model_facts, reason};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
 use crate::sim::{
@@ -218,24 +218,9 @@ fn assemble(
     options: &SimOptions,
 ) -> Result<Simulation, SimError> {
     let Prepared {
-        mut facts,
-        scene,
-        plan,
-        ..
+        facts, scene, plan, ..
     } = prepared;
-    let mut sim_facts = Facts::default();
-    for r in &records {
-        sim_facts.extend(r.facts());
-    }
-    facts.extend(sim_facts.clone());
-    let reasoned: Reasoned = reason(&facts, &options.engine, false)?;
-    Ok(Simulation {
-        scene,
-        plan,
-        records,
-        facts: sim_facts,
-        reasoned,
-    })
+    Simulation::from_records(facts, scene, plan, records, &options.engine)
 }
 
 /// Simulates the walls of one shard that the cache lacks, and stores them.

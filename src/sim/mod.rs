@@ -151,19 +151,39 @@ pub fn simulate_with_progress(
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
     let (scene, plan, records) = run_walls(model, model_name, cell, options, &mut facts, progress)?;
-    let mut sim_facts = Facts::default();
-    for r in &records {
-        sim_facts.extend(r.facts());
+    Simulation::from_records(facts, scene, plan, records, &options.engine)
+}
+
+impl Simulation {
+    /// The simulation of `records` (in wall order): their facts added to the model's and the
+    /// cell's `facts` and reasoned over with the rule base.
+    pub fn from_records(
+        mut facts: Facts,
+        scene: Scene,
+        plan: Plan,
+        records: Vec<WallRecord>,
+        engine: &RuleEngine,
+    ) -> Result<Simulation, SimError> {
+        let sim_facts = records_facts(&records);
+        facts.extend(sim_facts.clone());
+        let reasoned = reason(&facts, engine, false)?;
+        Ok(Simulation {
+            scene,
+            plan,
+            records,
+            facts: sim_facts,
+            reasoned,
+        })
     }
-    facts.extend(sim_facts.clone());
-    let reasoned = reason(&facts, &options.engine, false)?;
-    Ok(Simulation {
-        scene,
-        plan,
-        records,
-        facts: sim_facts,
-        reasoned,
-    })
+}
+
+/// The `rules/sim.dl` facts of some walls' records, in their order.
+fn records_facts(records: &[WallRecord]) -> Facts {
+    let mut facts = Facts::default();
+    for r in records {
+        facts.extend(r.facts());
+    }
+    facts
 }
 
 /// The `rules/sim.dl` facts of the walls `options.walls` names, without reasoning over
@@ -193,11 +213,7 @@ pub fn simulate_wall_facts(
         facts = restrict_to_containers(&facts, &containers);
     }
     let (_, _, records) = run_walls(model, "model", cell, options, &mut facts, &|_, _, _| {})?;
-    let mut sim_facts = Facts::default();
-    for r in &records {
-        sim_facts.extend(r.facts());
-    }
-    Ok(sim_facts)
+    Ok(records_facts(&records))
 }
 
 /// Places and reasons `facts` (a model's and a cell's), then runs the selected walls in

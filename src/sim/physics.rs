@@ -1124,14 +1124,20 @@ mod tests {
         (piece, pose)
     }
 
+    /// A world with piece "p" on conveyor 1 and the belts running.
+    fn piece_on_running_belt(cell: &Cell, dt: f64) -> Physics {
+        let mut phys = Physics::new(cell, &cell.robot.home(), dt);
+        let (piece, pose) = piece_on_deck(cell);
+        phys.add_lumber(&piece, &pose);
+        phys.set_belts(true, false);
+        phys
+    }
+
     #[test]
     fn a_riding_piece_moves_at_the_belt_speed_and_is_dynamic_again_when_the_belts_stop() {
         let cell = Cell::load("study-abb").expect("cell");
         let dt = 1.0 / 240.0;
-        let mut phys = Physics::new(&cell, &cell.robot.home(), dt);
-        let (piece, pose) = piece_on_deck(&cell);
-        phys.add_lumber(&piece, &pose);
-        phys.set_belts(true, false);
+        let mut phys = piece_on_running_belt(&cell, dt);
         for _ in 0..240 {
             phys.step();
         }
@@ -1166,10 +1172,7 @@ mod tests {
     fn a_parked_rider_stays_put_without_the_solver_and_is_dynamic_when_the_belts_start() {
         let cell = Cell::load("study-abb").expect("cell");
         let dt = 1.0 / 240.0;
-        let mut phys = Physics::new(&cell, &cell.robot.home(), dt);
-        let (piece, pose) = piece_on_deck(&cell);
-        phys.add_lumber(&piece, &pose);
-        phys.set_belts(true, false);
+        let mut phys = piece_on_running_belt(&cell, dt);
         let velocity = cell.conveyor1.direction() * cell.conveyor1.speed;
         phys.start_ride("p", &velocity);
         for _ in 0..24 {
@@ -1201,10 +1204,7 @@ mod tests {
     #[test]
     fn unparking_makes_parked_lumber_dynamic_at_rest() {
         let cell = Cell::load("study-abb").expect("cell");
-        let mut phys = Physics::new(&cell, &cell.robot.home(), 1.0 / 240.0);
-        let (piece, pose) = piece_on_deck(&cell);
-        phys.add_lumber(&piece, &pose);
-        phys.set_belts(true, false);
+        let mut phys = piece_on_running_belt(&cell, 1.0 / 240.0);
         phys.start_ride("p", &(cell.conveyor1.direction() * cell.conveyor1.speed));
         phys.set_belts(false, true);
         let generation = phys.generation();

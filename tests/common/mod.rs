@@ -20,3 +20,21 @@ pub fn shared_path(relative: &str) -> Option<PathBuf> {
         None
     }
 }
+
+/// `framewright synth block ARGS… -o DIR/block.ifc`: a generated model for a test.
+pub fn synth_block(dir: &Path, args: &[&str]) -> PathBuf {
+    let path = dir.join("block.ifc");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(["synth", "block"])
+        .args(args)
+        .arg("-o")
+        .arg(&path)
+        .output()
+        .expect("framewright runs");
+    assert!(
+        out.status.success(),
+        "synth block {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
