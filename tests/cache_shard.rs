@@ -2,6 +2,8 @@
 //! plain run afterwards assembles the result every wall of which comes from the cache,
 //! byte for byte the result of one uncached run (apart from the `sim.cache` counts).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -111,19 +113,7 @@ fn three_shards_of_a_generated_two_building_model_assemble_to_one_full_run() {
 
 /// A generated block of two storeys, one unit each (8 walls over two levels).
 fn generated_block(dir: &Path) -> PathBuf {
-    let path = dir.join("block.ifc");
-    ok(&[
-        "synth",
-        "block",
-        "--blocks",
-        "1",
-        "--storeys",
-        "2",
-        "--grid",
-        "1x1",
-        "-o",
-        path.to_str().unwrap(),
-    ]);
+    let path = common::synth_block(dir, &["--blocks", "1", "--storeys", "2", "--grid", "1x1"]);
     let plan: serde_json::Value =
         serde_json::from_str(&ok(&["plan", path.to_str().unwrap(), "--json"])).unwrap();
     let walls = plan["walls"].as_array().unwrap();

@@ -198,18 +198,15 @@ pub fn simulate_wall_facts(
 ) -> Result<Facts, SimError> {
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
-    let each_container: Option<BTreeSet<String>> = options
-        .walls
-        .iter()
-        .map(|w| {
-            let one = containers_of(&facts, &BTreeSet::from([w.as_str()]));
-            (!one.is_empty()).then_some(one)
-        })
-        .try_fold(BTreeSet::new(), |mut all, one| {
-            all.extend(one?);
-            Some(all)
-        });
-    if let Some(containers) = each_container.filter(|c| !c.is_empty()) {
+    // A wall named otherwise (by name, or by no piece) keeps the whole model.
+    let mut containers = BTreeSet::new();
+    let mut each_in_one = !options.walls.is_empty();
+    for wall in &options.walls {
+        let of_wall = containers_of(&facts, &BTreeSet::from([wall.as_str()]));
+        each_in_one &= !of_wall.is_empty();
+        containers.extend(of_wall);
+    }
+    if each_in_one {
         facts = restrict_to_containers(&facts, &containers);
     }
     let (_, _, records) = run_walls(model, "model", cell, options, &mut facts, &|_, _, _| {})?;

@@ -9,7 +9,7 @@ use crate::cell::{Arrangement, Cell, JointKind, PlacedShape, Shape};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, HashMap};
 
 /// Which pairs lumber collides in: the defaults, and a held (kinematic) piece with fixed
 /// bodies too. A piece riding a belt (`start_ride`) drops the latter.
@@ -127,10 +127,9 @@ pub struct Physics {
     /// Counts the changes that may set lumber moving: all but a piece starting to ride (it
     /// moves at its belt's speed, touching nothing). Settling is judged from the last one.
     disturbances: u64,
-    /// Pieces riding a running belt as kinematic bodies (see `start_ride`).
+    /// Pieces riding a running belt as kinematic bodies (see `start_ride`); while the belts
+    /// stand, the riders they left parked (see `set_belts`).
     riding: BTreeMap<String, LumberBody>,
-    /// Riders of the stopped belts left kinematic at rest (see `set_belts`); also in `riding`.
-    parked: BTreeSet<String>,
     /// The joints and held piece `place_robot` last put the robot's bodies at, until
     /// anything else may have moved them (a step, a drive, a carry, a change to the world).
     placed: Option<RobotPlacement>,
@@ -401,7 +400,6 @@ impl Physics {
             generation: 0,
             disturbances: 0,
             riding: BTreeMap::new(),
-            parked: BTreeSet::new(),
             placed: None,
             ride_exact: HashMap::new(),
         }
@@ -451,11 +449,14 @@ impl Physics {
     /// Lets a piece ride its running belt as a kinematic body at `velocity` (m/s): a piece
     /// that only rides has nothing for the solver to do, and without contacts to the belt it
     /// costs none. The feeder ends the ride (`end_ride`) before the piece nears anything;
-    /// stopping the belts ends every ride.
+    /// stopping the belts ends every ride or parks it. A standing belt carries nothing.
     pub fn start_ride(&mut self, id: &str, velocity: &Vector3<f64>) {
         let Some(b) = self.lumber.get(id).copied() else {
             return;
         };
+        if !self.belts.running {
+            return;
+        }
         if self.riding.insert(id.to_string(), b).is_some() {
             return;
         }
@@ -474,7 +475,6 @@ impl Physics {
 
     /// A riding piece is a dynamic body again, moving as it rode.
     pub fn end_ride(&mut self, id: &str) {
-        self.parked.remove(id);
         let Some(b) = self.riding.remove(id) else {
             return;
         };
@@ -537,7 +537,6 @@ impl Physics {
     /// Takes a piece out of the world (an operator lifts it off the belt).
     pub fn remove_lumber(&mut self, id: &str) {
         self.riding.remove(id);
-        self.parked.remove(id);
         self.changed(true);
         if let Some(b) = self.lumber.remove(id) {
             self.ride_exact.remove(&b.body);
@@ -692,7 +691,10 @@ impl Physics {
             let riding: Vec<String> = self.riding.keys().cloned().collect();
             for id in riding {
                 if park {
-                    self.park(&id);
+                    // Still a rider, at rest: `advance_rides` leaves it where it is.
+                    if let Some(b) = self.riding.get(&id) {
+                        self.ride_exact.remove(&b.body);
+                    }
                 } else {
                     self.end_ride(&id);
                 }
@@ -711,18 +713,13 @@ impl Physics {
         self.belts.running = running;
     }
 
-    /// A rider of a stopping belt stays a kinematic body, at rest and still without contacts.
-    fn park(&mut self, id: &str) {
-        if let Some(b) = self.lumber.get(id) {
-            self.ride_exact.remove(&b.body);
-        }
-        self.parked.insert(id.to_string());
-    }
-
     /// Every parked piece becomes a dynamic body at rest where it lies, as stopping the belts
     /// without parking leaves it: before the belts start, or before the robot comes near one.
     pub fn unpark(&mut self) {
-        let parked: Vec<String> = std::mem::take(&mut self.parked).into_iter().collect();
+        if self.belts.running {
+            return; // riders of running belts are not parked
+        }
+        let parked: Vec<String> = self.riding.keys().cloned().collect();
         for id in parked {
             self.end_ride(&id);
             if let Some(b) = self.lumber.get(&id) {
@@ -912,16 +909,12 @@ impl Physics {
         }
         // Riders are measured apart, where they are now: between steps the broad phase holds
         // them where the last step left them.
-        let riders: Vec<(&str, LumberBody)> = self
-            .riding
-            .iter()
-            .map(|(id, b)| (id.as_str(), *b))
-            .collect();
+        let riders: Vec<LumberBody> = self.riding.values().copied().collect();
         let predicate = |_: ColliderHandle, c: &Collider| {
             !c.is_sensor()
                 && !c
                     .parent()
-                    .is_some_and(|b| own.contains(&b) || riders.iter().any(|(_, r)| r.body == b))
+                    .is_some_and(|b| own.contains(&b) || riders.iter().any(|r| r.body == b))
         };
         let mut found = Clearance {
             any: reach,
@@ -956,7 +949,7 @@ impl Physics {
             }
             // A rider moves on its own: it counts as loose.
             let reach_box = shape.compute_aabb(&pose).loosened(reach as f32);
-            for (id, r) in &riders {
+            for r in &riders {
                 if !collider
                     .collision_groups()
                     .test(self.world.colliders[r.collider].collision_groups())
@@ -974,7 +967,7 @@ impl Physics {
                     .map_or(0.0, |d| f64::from(d.distance).min(reach));
                 found.any = found.any.min(d);
                 found.loose = found.loose.min(d);
-                if self.parked.contains(*id) {
+                if !self.belts.running {
                     found.parked = found.parked.min(d);
                 }
             }
@@ -1220,6 +1213,9 @@ mod tests {
             phys.clearance(&cell.robot.home(), None, 100.0).parked,
             100.0
         );
+        // A standing belt carries nothing: no ride starts on it.
+        phys.start_ride("p", &(cell.conveyor1.direction() * cell.conveyor1.speed));
+        assert!(!phys.is_riding("p") && phys.world.bodies[body].is_dynamic());
     }
 
     #[test]
