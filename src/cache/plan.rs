@@ -393,11 +393,19 @@ fn merge(partition: &Partition, results: Vec<Option<Relations>>) -> Relations {
     }
     let mut order: Vec<usize> = (0..partition.containers.len()).collect();
     order.sort_by_key(|&c| std::cmp::Reverse(partition.containers[c].pieces.len()));
-    let mut merged = Relations::new();
-    for c in order {
-        for (name, mut rows) in std::mem::take(&mut by_container[c]) {
+    let mut ordered: Vec<Relations> = order
+        .into_iter()
+        .map(|c| std::mem::take(&mut by_container[c]))
+        .collect();
+    ordered.par_iter_mut().for_each(|relations| {
+        relations.par_iter_mut().for_each(|(_, rows)| {
             rows.sort();
             rows.dedup();
+        })
+    });
+    let mut merged = Relations::new();
+    for relations in ordered {
+        for (name, rows) in relations {
             merged.entry(name).or_default().extend(rows);
         }
     }

@@ -4,7 +4,7 @@
 
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::{ReasoningInputs, load_model_facts, rule_base};
-use super::{CmdResult, print_stdout, write_stdout};
+use super::{CmdResult, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::reason_plan_cached;
 use framewright::frame::placement::add_placement_facts;
 use framewright::frame::plan::Plan;
@@ -50,9 +50,11 @@ pub fn run(args: PlanArgs) -> CmdResult {
     warn_if_unwritable(cache.as_ref());
     let mut report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
     report.cache = counts;
-    if args.json {
+    let written = if args.json {
         write_stdout(|out| report.write_json(&mut &mut *out))
     } else {
         print_stdout(&report.to_text())
-    }
+    };
+    leave_to_exit((model, reasoned, report));
+    written
 }

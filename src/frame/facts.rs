@@ -147,17 +147,19 @@ pub fn obox_value(b: &OrientedBox) -> Value {
 /// The facts of a model: pieces, their boxes, groups, containers, materials and contacts.
 pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
     let mut facts = Facts::default();
+    // Names that repeat (types, materials, containers, contact kinds) share one symbol.
+    let mut names = Symbols::default();
+    let ids: Vec<Value> = model.pieces().iter().map(|p| sym(&p.id)).collect();
     for (index, p) in model.pieces().iter().enumerate() {
         let origin = Origin::Entity(p.entity);
-        let id = sym(&p.id);
-        let text = |s: &Option<String>| sym(s.as_deref().unwrap_or(""));
+        let id = ids[index].clone();
         facts.add(
             "piece",
             vec![
                 id.clone(),
                 Value::Number(p.entity as i64),
-                sym(&p.ifc_type),
-                text(&p.name),
+                names.get(&p.ifc_type),
+                names.text(&p.name),
             ],
             origin.clone(),
         );
@@ -183,7 +185,11 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
         );
         facts.add(
             "piece_type",
-            vec![id.clone(), text(&p.predefined_type), text(&p.object_type)],
+            vec![
+                id.clone(),
+                names.text(&p.predefined_type),
+                names.text(&p.object_type),
+            ],
             origin.clone(),
         );
         if let Some(group) = p.parent.and_then(|g| model.groups.get(&g)) {
@@ -191,9 +197,9 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
                 "piece_group",
                 vec![
                     id.clone(),
-                    sym(&group.global_id),
-                    sym(&group.ifc_type),
-                    text(&group.name),
+                    names.get(&group.global_id),
+                    names.get(&group.ifc_type),
+                    names.text(&group.name),
                 ],
                 Origin::Entity(group.entity),
             );
@@ -203,14 +209,14 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
             "piece_container",
             vec![
                 id.clone(),
-                sym(container.map_or("", |c| c.global_id.as_str())),
+                names.get(container.map_or("", |c| c.global_id.as_str())),
             ],
             container.map_or(origin.clone(), |c| Origin::Entity(c.entity)),
         );
         let (density, _) = density_of(p.material.as_deref());
         facts.add(
             "piece_material",
-            vec![id.clone(), text(&p.material), Value::float(density)],
+            vec![id.clone(), names.text(&p.material), Value::float(density)],
             origin,
         );
     }
@@ -218,15 +224,16 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
     for c in contacts(&boxes, contact_options) {
         let (a, b) = (&model.pieces()[c.a], &model.pieces()[c.b]);
         let origin = Origin::Entity(a.entity);
-        let kind = sym(c.kind.name());
+        let kind = names.get(c.kind.name());
+        let (face_a, face_b) = (names.get(c.face_a.name()), names.get(c.face_b.name()));
         facts.add(
             "contact",
             vec![
-                sym(&a.id),
-                sym(&b.id),
+                ids[c.a].clone(),
+                ids[c.b].clone(),
                 kind.clone(),
-                sym(c.face_a.name()),
-                sym(c.face_b.name()),
+                face_a.clone(),
+                face_b.clone(),
                 Value::float(c.gap),
                 vec3(&c.normal),
                 vec3(&c.centre.coords),
@@ -236,11 +243,11 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
         facts.add(
             "contact",
             vec![
-                sym(&b.id),
-                sym(&a.id),
+                ids[c.b].clone(),
+                ids[c.a].clone(),
                 kind,
-                sym(c.face_b.name()),
-                sym(c.face_a.name()),
+                face_b,
+                face_a,
                 Value::float(c.gap),
                 vec3(&-c.normal),
                 vec3(&c.centre.coords),
@@ -249,4 +256,24 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
         );
     }
     facts
+}
+
+/// One symbol per distinct name: fewer allocations to make and to free.
+#[derive(Default)]
+struct Symbols(FxHashMap<String, Value>);
+
+impl Symbols {
+    fn get(&mut self, name: &str) -> Value {
+        if let Some(v) = self.0.get(name) {
+            return v.clone();
+        }
+        let v = sym(name);
+        self.0.insert(name.to_string(), v.clone());
+        v
+    }
+
+    /// An optional text, "" when absent.
+    fn text(&mut self, text: &Option<String>) -> Value {
+        self.get(text.as_deref().unwrap_or(""))
+    }
 }

@@ -15,6 +15,7 @@ use super::Facts;
 use crate::logic::compiled::Relations;
 use crate::logic::{OBox, Value};
 use nalgebra::Vector3;
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 /// One independent part of a container.
@@ -138,25 +139,35 @@ impl Partition {
             parts[k].groups = groups;
         }
 
-        for (name, tuples) in &facts.tuples {
-            let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); parts.len()];
-            for (tuple, _) in tuples {
-                match find(tuple.first()).map(|p| part_of[p]) {
-                    Some(k) if *name == "contact" => {
-                        if find(tuple.get(1)).map(|p| part_of[p]) == Some(k) {
-                            buckets[k].push(tuple.clone());
+        // Each relation split into its parts' buckets, relations and buckets in parallel.
+        let split: Vec<(&str, Vec<Vec<Vec<Value>>>)> = facts
+            .tuples
+            .par_iter()
+            .map(|(name, tuples)| {
+                let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); parts.len()];
+                for (tuple, _) in tuples {
+                    match find(tuple.first()).map(|p| part_of[p]) {
+                        Some(k) if *name == "contact" => {
+                            if find(tuple.get(1)).map(|p| part_of[p]) == Some(k) {
+                                buckets[k].push(tuple.clone());
+                            }
                         }
+                        Some(k) => buckets[k].push(tuple.clone()),
+                        None => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
                     }
-                    Some(k) => buckets[k].push(tuple.clone()),
-                    None => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
                 }
-            }
-            for (part, mut bucket) in parts.iter_mut().zip(buckets) {
-                if *name == "piece_index" {
-                    renumber(&mut bucket);
-                }
-                bucket.sort();
-                bucket.dedup();
+                buckets.par_iter_mut().for_each(|bucket| {
+                    if *name == "piece_index" {
+                        renumber(bucket);
+                    }
+                    bucket.sort();
+                    bucket.dedup();
+                });
+                (*name, buckets)
+            })
+            .collect();
+        for (name, buckets) in split {
+            for (part, bucket) in parts.iter_mut().zip(buckets) {
                 part.relations.insert(name.to_string(), bucket);
             }
         }

@@ -6,6 +6,7 @@ use crate::geom::Point3;
 use crate::ifc::Model;
 use crate::logic::Value;
 use nalgebra::{Isometry3, Vector3};
+use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
 
 #[derive(Debug, Clone)]
@@ -52,8 +53,12 @@ pub struct NailingTarget {
     pub direction: Vector3<f64>,
 }
 
-fn sym(v: &Value) -> String {
-    v.as_symbol().unwrap_or_default().to_string()
+fn sym(v: &Value) -> &str {
+    v.as_symbol().unwrap_or_default()
+}
+
+fn owned(v: &Value) -> String {
+    sym(v).to_string()
 }
 
 fn float(v: &Value) -> f64 {
@@ -96,160 +101,166 @@ impl Plan {
 
     /// Collects the plan from the rule base's relations (missing relations give empty parts).
     pub fn from_reasoned(model: &Model, r: &Reasoned) -> Plan {
-        let index: BTreeMap<&str, usize> = model
+        use rayon::prelude::*;
+        // Lookups borrow the relations' symbols; only what the plan keeps is copied.
+        let index: FxHashMap<&str, usize> = model
             .pieces()
             .iter()
             .enumerate()
             .map(|(i, p)| (p.id.as_str(), i))
             .collect();
-        let wall_of: BTreeMap<String, String> = r
-            .get("wall_of")
-            .iter()
-            .map(|t| (sym(&t[0]), sym(&t[1])))
-            .collect();
-        let roles: BTreeMap<String, String> = r
-            .get("role")
-            .iter()
-            .map(|t| (sym(&t[0]), sym(&t[1])))
+        let file_order = |p: &str| index.get(p).copied().unwrap_or(usize::MAX);
+        let pairs = |relation: &str| -> Vec<(&str, &str)> {
+            r.get(relation)
+                .iter()
+                .map(|t| (sym(&t[0]), sym(&t[1])))
+                .collect()
+        };
+        let wall_pairs = pairs("wall_of");
+        let wall_of_piece: FxHashMap<&str, &str> = wall_pairs.iter().copied().collect();
+        let roles: BTreeMap<String, String> = pairs("role")
+            .into_iter()
+            .map(|(p, role)| (p.to_string(), role.to_string()))
             .collect();
         let masses: BTreeMap<String, f64> = r
             .get("piece_material")
             .iter()
             .filter_map(|t| {
-                let p = model.pieces().get(*index.get(sym(&t[0]).as_str())?)?;
+                let p = model.pieces().get(*index.get(sym(&t[0]))?)?;
                 Some((p.id.clone(), p.obox.volume() * float(&t[2])))
             })
             .collect();
-        let groups: BTreeMap<String, (String, String)> = r
+        let groups: FxHashMap<&str, (&str, &str)> = r
             .get("wall_group")
             .iter()
             .map(|t| (sym(&t[0]), (sym(&t[1]), sym(&t[3]))))
             .collect();
-        let frames: BTreeMap<String, Isometry3<f64>> = r
+        let frames: FxHashMap<&str, Isometry3<f64>> = r
             .get("wall_frame")
             .iter()
             .map(|t| (sym(&t[0]), iso(&t[1])))
             .collect();
-        let sizes: BTreeMap<String, [f64; 3]> = r
+        let sizes: FxHashMap<&str, [f64; 3]> = r
             .get("wall_size")
             .iter()
             .map(|t| (sym(&t[0]), [float(&t[1]), float(&t[2]), float(&t[3])]))
             .collect();
-        let ranks: BTreeMap<String, i64> = r
+        let ranks: FxHashMap<&str, i64> = r
             .get("assembly_rank")
             .iter()
             .map(|t| (sym(&t[0]), t[1].as_number().unwrap_or(i64::MAX)))
             .collect();
 
         // Walls in file order of their key piece.
-        let mut keys: Vec<String> = r.get("wall").iter().map(|t| sym(&t[0])).collect();
-        keys.sort_by_key(|k| index.get(k.as_str()).copied().unwrap_or(usize::MAX));
-        let mut members: BTreeMap<&str, Vec<String>> = BTreeMap::new();
-        for (p, w) in &wall_of {
-            members.entry(w.as_str()).or_default().push(p.clone());
+        let mut keys: Vec<&str> = r.get("wall").iter().map(|t| sym(&t[0])).collect();
+        keys.sort_by_key(|k| file_order(k));
+        // Members, precedence, nailing and framing targets bucketed by wall in one pass each.
+        let mut members: FxHashMap<&str, Vec<&str>> = FxHashMap::default();
+        for (p, w) in &wall_of_piece {
+            members.entry(w).or_default().push(p);
         }
-        // Precedence, nailing and framing targets bucketed by wall in one pass.
-        let mut precedence_by: BTreeMap<&str, Vec<(String, String, String)>> = BTreeMap::new();
+        let mut precedence_by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
         for t in r.get("precedence") {
-            let (before, after) = (sym(&t[0]), sym(&t[1]));
-            if let (Some(w), Some(w2)) = (wall_of.get(&before), wall_of.get(&after))
+            if let (Some(w), Some(w2)) =
+                (wall_of_piece.get(sym(&t[0])), wall_of_piece.get(sym(&t[1])))
                 && w == w2
             {
-                precedence_by
-                    .entry(w.as_str())
-                    .or_default()
-                    .push((before, after, sym(&t[2])));
+                precedence_by.entry(w).or_default().push(t);
             }
         }
-        let mut nails_by: BTreeMap<&str, Vec<NailingTarget>> = BTreeMap::new();
-        for t in r.get("nailing_target") {
-            if let Some(w) = wall_of.get(&sym(&t[0])) {
-                nails_by.entry(w.as_str()).or_default().push(NailingTarget {
-                    plate: sym(&t[0]),
-                    member: sym(&t[1]),
-                    kind: sym(&t[2]),
-                    u: float(&t[3]),
-                    v: float(&t[4]),
-                    w: float(&t[5]),
-                    world: Point3::from(vec3(&t[6])),
-                    direction: vec3(&t[7]),
+        let by_wall_of_first = |relation: &str| {
+            let mut by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
+            for t in r.get(relation) {
+                if let Some(w) = wall_of_piece.get(sym(&t[0])) {
+                    by.entry(w).or_default().push(t);
+                }
+            }
+            by
+        };
+        let nails_by = by_wall_of_first("nailing_target");
+        let framing_by = by_wall_of_first("framing_target");
+        let walls: Vec<Wall> = keys
+            .par_iter()
+            .enumerate()
+            .map(|(n, &key)| {
+                let mut list = members.get(key).cloned().unwrap_or_default();
+                list.sort_by_key(|p| (file_order(p), *p));
+                let mut order = list.clone();
+                order.sort_by_key(|p| (ranks.get(p).copied().unwrap_or(i64::MAX), file_order(p)));
+                let mut precedence: Vec<(String, String, String)> = precedence_by
+                    .get(key)
+                    .into_iter()
+                    .flatten()
+                    .map(|t| (owned(&t[0]), owned(&t[1]), owned(&t[2])))
+                    .collect();
+                precedence.sort();
+                let mut nailing_targets: Vec<NailingTarget> = nails_by
+                    .get(key)
+                    .into_iter()
+                    .flatten()
+                    .map(|t| NailingTarget {
+                        plate: owned(&t[0]),
+                        member: owned(&t[1]),
+                        kind: owned(&t[2]),
+                        u: float(&t[3]),
+                        v: float(&t[4]),
+                        w: float(&t[5]),
+                        world: Point3::from(vec3(&t[6])),
+                        direction: vec3(&t[7]),
+                    })
+                    .collect();
+                nailing_targets.sort_by(|a, b| {
+                    (a.u, a.v, a.w)
+                        .partial_cmp(&(b.u, b.v, b.w))
+                        .unwrap_or(std::cmp::Ordering::Equal)
                 });
-            }
-        }
-        let mut framing_by: BTreeMap<&str, Vec<(String, Isometry3<f64>)>> = BTreeMap::new();
-        for t in r.get("framing_target") {
-            if let Some(w) = wall_of.get(&sym(&t[0])) {
-                framing_by
-                    .entry(w.as_str())
-                    .or_default()
-                    .push((sym(&t[0]), iso(&t[1])));
-            }
-        }
-        let mut walls = Vec::new();
-        for (n, key) in keys.iter().enumerate() {
-            let mut list = members.get(key.as_str()).cloned().unwrap_or_default();
-            list.sort_by_key(|p| index.get(p.as_str()).copied().unwrap_or(usize::MAX));
-            let mut order = list.clone();
-            order.sort_by_key(|p| {
-                (
-                    ranks.get(p).copied().unwrap_or(i64::MAX),
-                    index.get(p.as_str()).copied(),
-                )
-            });
-            let mut precedence = precedence_by.remove(key.as_str()).unwrap_or_default();
-            precedence.sort();
-            let mut nailing_targets = nails_by.remove(key.as_str()).unwrap_or_default();
-            nailing_targets.sort_by(|a, b| {
-                (a.u, a.v, a.w)
-                    .partial_cmp(&(b.u, b.v, b.w))
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            });
-            let position: BTreeMap<&str, usize> = order
-                .iter()
-                .enumerate()
-                .map(|(i, p)| (p.as_str(), i))
-                .collect();
-            let mut framing_targets = framing_by.remove(key.as_str()).unwrap_or_default();
-            framing_targets.sort_by_key(|(p, _)| position.get(p.as_str()).copied());
-            let group = groups.get(key);
-            let size = sizes.get(key).copied().unwrap_or([f64::NAN; 3]);
-            walls.push(Wall {
-                id: group.map_or_else(|| format!("W{}", n + 1), |(g, _)| g.clone()),
-                name: group.map_or_else(|| format!("Wall {}", n + 1), |(_, name)| name.clone()),
-                key: key.clone(),
-                group_global_id: group.map(|(g, _)| g.clone()),
-                members: list,
-                frame: frames.get(key).copied().unwrap_or_else(Isometry3::identity),
-                length: size[0],
-                height: size[1],
-                thickness: size[2],
-                assembly_order: order,
-                precedence,
-                nailing_targets,
-                framing_targets,
-            });
-        }
-        let wall_ids: BTreeMap<&str, &str> = walls
+                let position: FxHashMap<&str, usize> =
+                    order.iter().enumerate().map(|(i, p)| (*p, i)).collect();
+                let mut framing: Vec<(&str, Isometry3<f64>)> = framing_by
+                    .get(key)
+                    .into_iter()
+                    .flatten()
+                    .map(|t| (sym(&t[0]), iso(&t[1])))
+                    .collect();
+                framing.sort_by_key(|(p, _)| position.get(p).copied());
+                let group = groups.get(key);
+                let size = sizes.get(key).copied().unwrap_or([f64::NAN; 3]);
+                let strings = |v: Vec<&str>| v.into_iter().map(str::to_string).collect();
+                Wall {
+                    id: group.map_or_else(|| format!("W{}", n + 1), |(g, _)| g.to_string()),
+                    name: group
+                        .map_or_else(|| format!("Wall {}", n + 1), |(_, name)| name.to_string()),
+                    key: key.to_string(),
+                    group_global_id: group.map(|(g, _)| g.to_string()),
+                    members: strings(list),
+                    frame: frames.get(key).copied().unwrap_or_else(Isometry3::identity),
+                    length: size[0],
+                    height: size[1],
+                    thickness: size[2],
+                    assembly_order: strings(order),
+                    precedence,
+                    nailing_targets,
+                    framing_targets: framing
+                        .into_iter()
+                        .map(|(p, pose)| (p.to_string(), pose))
+                        .collect(),
+                }
+            })
+            .collect();
+        let wall_ids: FxHashMap<&str, &str> = walls
             .iter()
             .map(|w| (w.key.as_str(), w.id.as_str()))
             .collect();
-        let wall_of = wall_of
+        let wall_of = wall_of_piece
             .iter()
-            .map(|(p, w)| {
-                (
-                    p.clone(),
-                    wall_ids.get(w.as_str()).unwrap_or(&w.as_str()).to_string(),
-                )
-            })
+            .map(|(p, w)| (p.to_string(), wall_ids.get(w).unwrap_or(w).to_string()))
             .collect();
         let mut warnings: Vec<String> = r
             .get("frame_warning")
             .iter()
             .map(|t| {
                 let subject = sym(&t[0]);
-                let subject = wall_ids
-                    .get(subject.as_str())
-                    .map_or(subject.clone(), |w| w.to_string());
+                let subject = wall_ids.get(subject).copied().unwrap_or(subject);
                 format!("{subject}: {}", sym(&t[1]))
             })
             .collect();
