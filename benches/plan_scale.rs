@@ -4,16 +4,21 @@
 //! members, 46 MB), planned with the study's cell (placement search on) the way
 //! `framewright plan --json` does it, phase by phase; then the path before (one search per
 //! target, every offset a placement candidate, every relation converted to `Value` tuples),
-//! and the ratio.
+//! and the ratio. Then `plan` as it runs by default, through the cache: a first run into an
+//! empty cache folder and a second, warm run, each with its ratio to the uncached run
+//! measured here (the JSON checked equal to it but for the `cache` block).
 //!
 //! `cargo bench --bench plan_scale` (`-- --storeys 1` for a quick run; `-- --skip-old` to
 //! time only the current path; `PLAN_SCALE_SIZES=1` also prints the largest relations).
 //! Peak memory: `/usr/bin/time -v framewright plan --json M.ifc`.
 
+use framewright::cache::{Cache, reason_plan_cached};
 use framewright::cell::Cell;
 use framewright::frame::placement::{SearchOptions, add_placement_facts_with};
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, cell_facts, model_facts, reason, reason_selected};
+use framewright::frame::{
+    RuleEngine, RuleLimits, cell_facts, model_facts, reason, reason_selected,
+};
 use framewright::ifc::Model;
 use framewright::report::plan::PlanReport;
 use framewright::synth::building::{BlockSpec, blocks};
@@ -66,6 +71,27 @@ fn plan(path: &Path, options: &SearchOptions, label: &str) -> (f64, Vec<u8>) {
     (start.elapsed().as_secs_f64(), json)
 }
 
+/// Runs `plan --json` through the cache folder `cache` (the reasoning per part, stored and
+/// read back); returns the total seconds and the JSON without the `cache` block.
+fn plan_cached(path: &Path, cache: &Cache, label: &str) -> (f64, Vec<u8>) {
+    let start = Instant::now();
+    let model = Model::open(path).expect("read");
+    let cell = Cell::load("study-abb").expect("cell");
+    let mut facts = model_facts(&model, &Default::default());
+    facts.extend(cell_facts(&cell));
+    let limits = RuleLimits::from_env().expect("limits");
+    let (reasoned, counts) = reason_plan_cached(facts, &cell, cache, &limits).expect("reason");
+    let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
+    let mut json = Vec::new();
+    report.write_json(&mut json).expect("json");
+    let seconds = start.elapsed().as_secs_f64();
+    eprintln!(
+        "  {label} walls reasoned {}, from the cache {}",
+        counts.computed, counts.cached
+    );
+    (seconds, json)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let storeys = args
@@ -110,6 +136,16 @@ fn main() {
     );
     let (now, json) = plan(&path, &SearchOptions::default(), "shared");
     println!("plan_scale now: {now:.2} s");
+    let cache_dir = tempfile::tempdir().expect("cache dir");
+    let cache = Cache::new(cache_dir.path());
+    let (first, first_json) = plan_cached(&path, &cache, "cache, first run");
+    let (warm, warm_json) = plan_cached(&path, &cache, "cache, warm run ");
+    println!(
+        "plan_scale through the cache: first run {first:.2} s ({:.2}x the uncached run), warm {warm:.2} s ({:.2}x faster than uncached; same JSON: {})",
+        first / now,
+        now / warm,
+        first_json == json && warm_json == json
+    );
     if skip_old {
         return;
     }
