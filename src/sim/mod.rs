@@ -223,7 +223,6 @@ fn run_walls(
     facts: &mut Facts,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<(Scene, Plan, Vec<WallRecord>), SimError> {
-    use rayon::prelude::*;
     check_options(options)?;
     let limit = max_sim_seconds_per_wall()?;
     crate::frame::placement::add_placement_facts(facts, cell, &options.engine)?;
@@ -232,30 +231,73 @@ fn run_walls(
     let plan = Plan::from_reasoned(model, &planned);
     let selected = select_walls(&plan, &options.walls)?;
 
-    let records: Vec<WallRecord> = selected
-        .par_iter()
-        .filter_map(|key| -> Option<Result<WallRecord, SimError>> {
-            // The rules name a wall by its key piece; the scene does too.
-            let scene_wall = scene.walls.iter().find(|w| &w.id == key)?;
-            let plan_wall = plan.walls.iter().find(|w| &w.key == key)?;
-            let pieces = scene_wall
-                .pieces
-                .iter()
-                .filter_map(|id| scene.pieces.iter().find(|p| &p.id == id))
-                .collect();
-            let nails = NailPlan::from_targets(&plan_wall.nailing_targets, &plan_wall.frame);
-            let report = |done: usize, total: usize| progress(&plan_wall.name, done, total);
-            let run = executor::WallRun::new(cell, options, scene_wall, pieces, &report)
-                .with_time_limit(limit)
-                .run(&nails);
-            Some(run.map_err(|reached| SimError::TimeLimit {
-                wall: format!("{} ({})", plan_wall.name, plan_wall.id),
-                limit,
-                reached,
-            }))
-        })
-        .collect::<Result<_, _>>()?;
+    let run_wall = |key: &String| -> Option<Result<WallRecord, SimError>> {
+        // The rules name a wall by its key piece; the scene does too.
+        let scene_wall = scene.walls.iter().find(|w| &w.id == key)?;
+        let plan_wall = plan.walls.iter().find(|w| &w.key == key)?;
+        let pieces = scene_wall
+            .pieces
+            .iter()
+            .filter_map(|id| scene.pieces.iter().find(|p| &p.id == id))
+            .collect();
+        let nails = NailPlan::from_targets(&plan_wall.nailing_targets, &plan_wall.frame);
+        let report = |done: usize, total: usize| progress(&plan_wall.name, done, total);
+        let run = executor::WallRun::new(cell, options, scene_wall, pieces, &report)
+            .with_time_limit(limit)
+            .run(&nails);
+        Some(run.map_err(|reached| SimError::TimeLimit {
+            wall: format!("{} ({})", plan_wall.name, plan_wall.id),
+            limit,
+            reached,
+        }))
+    };
+    let cost = |key: &String| {
+        scene
+            .walls
+            .iter()
+            .find(|w| &w.id == key)
+            .map_or(0, |w| w.pieces.len())
+    };
+    let records = largest_first(&selected, cost, run_wall)
+        .into_iter()
+        .flatten()
+        .collect::<Result<Vec<WallRecord>, SimError>>()?;
     Ok((scene, plan, records))
+}
+
+/// `run` on every item on all threads, the costliest first (each thread takes the next item
+/// when it is done), so that no long job starts last while the other threads idle; the
+/// results come back in the items' order.
+fn largest_first<T: Sync, R: Send>(
+    items: &[T],
+    cost: impl Fn(&T) -> usize,
+    run: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    use rayon::prelude::*;
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let mut order: Vec<usize> = (0..items.len()).collect();
+    order.sort_by_key(|&i| (std::cmp::Reverse(cost(&items[i])), i));
+    let next = AtomicUsize::new(0);
+    let results: Vec<Mutex<Option<R>>> = items.iter().map(|_| Mutex::new(None)).collect();
+    // One taker per thread; a taker whose thread is busy elsewhere (a nested call) starts
+    // late or not at all, and the others take its share.
+    (0..rayon::current_num_threads())
+        .into_par_iter()
+        .for_each(|_| {
+            while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                let r = run(&items[i]);
+                *results[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+            }
+        });
+    results
+        .into_iter()
+        .map(|m| {
+            m.into_inner()
+                .unwrap_or_else(|e| e.into_inner())
+                .expect("every item runs once")
+        })
+        .collect()
 }
 
 /// The option checks of `simulate`: a time step in (0, 0.05] s, a speed fraction in (0, 1].
@@ -313,4 +355,37 @@ pub fn select_walls(plan: &Plan, wanted: &[String]) -> Result<Vec<String>, SimEr
         .filter(|w| ids.contains(&w.key))
         .map(|w| w.key.clone())
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn largest_first_returns_in_item_order_and_starts_with_the_costliest() {
+        let items = [3usize, 9, 1, 9, 4];
+        let started = std::sync::Mutex::new(Vec::new());
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .expect("a pool");
+        let out = pool.install(|| {
+            super::largest_first(
+                &items,
+                |x| *x,
+                |x| {
+                    started.lock().expect("not poisoned").push(*x);
+                    x * 10
+                },
+            )
+        });
+        assert_eq!(out, vec![30, 90, 10, 90, 40]);
+        // One thread takes them costliest first (ties in item order).
+        assert_eq!(
+            started.into_inner().expect("not poisoned"),
+            vec![9, 9, 4, 3, 1]
+        );
+        // Many threads: every item once, results in order.
+        let many: Vec<usize> = (0..200).collect();
+        let out = super::largest_first(&many, |x| x % 7, |x| x + 1);
+        assert_eq!(out, (1..=200).collect::<Vec<usize>>());
+    }
 }
