@@ -3,7 +3,7 @@
 
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::load_cell;
-use super::{CmdResult, Failure, print_stdout, write_stdout};
+use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::{Need, Shard, simulate_cached_for, simulate_shard};
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
@@ -142,11 +142,13 @@ pub fn run(args: SimulateArgs) -> CmdResult {
             Failure::bad_input(format!("{}: cannot write the report: {e}", dir.display()))
         })?;
     }
-    if args.json {
+    let written = if args.json {
         write_stdout(|out| report.write_json(out))
     } else {
         print_stdout(&report.to_terminal(args.verbose))
-    }
+    };
+    leave_to_exit((model, sim, report));
+    written
 }
 
 /// One progress bar per wall on a terminal (stderr); nothing otherwise.
