@@ -96,10 +96,9 @@ impl PlanReport {
             .iter()
             .map(|w| (w.id.as_str(), &w.frame))
             .collect();
-        use rayon::prelude::*;
         let members = model
             .pieces()
-            .par_iter()
+            .iter()
             .map(|p| {
                 let wall_id = plan.wall_of.get(&p.id).cloned();
                 let (mut start, mut end) = p.axis();
@@ -132,7 +131,7 @@ impl PlanReport {
             .collect();
         let walls = plan
             .walls
-            .par_iter()
+            .iter()
             .map(|w| {
                 let m = w.frame.to_homogeneous();
                 let frame_matrix = [0, 1, 2, 3].map(|i| {

@@ -23,11 +23,11 @@ use nalgebra::Isometry3;
 const CALM_LINEAR: f64 = 2e-4;
 const CALM_ANGULAR: f64 = 2e-3;
 /// Physics steps with all lumber at rest, after the last change to the world, before the
-/// solver may pause (0.125 s at 240 Hz). A piece that can still move under gravity leaves the
-/// CALM_ thresholds within a step or two (one 240 Hz step of free fall is 0.04 m/s), so a
-/// longer wait only holds back pieces that have settled: 60 steps gave the same verdicts on
-/// TM1-TM3 (both study cells) and on every element of the 4,020-member model, with 21 % more
-/// solver steps.
+/// solver may pause (0.125 s at 240 Hz). A piece that can still move under gravity exceeds
+/// CALM_LINEAR or CALM_ANGULAR within a step or two (one 240 Hz step of free fall is
+/// 0.04 m/s), so a longer wait only holds back pieces that have settled: 60 steps gave the
+/// same verdicts on TM1-TM3 (both study cells) and on every element of the 4,020-member
+/// model, with 21 % more solver steps.
 const CALM_STEPS: u32 = 30;
 /// Within this of loose lumber the robot is stepped with the solver (m).
 const LOOSE_MARGIN: f64 = 0.02;
