@@ -226,7 +226,12 @@ impl Robot {
         let target = tip_target(pose, tcp)?;
         let mut solutions = match &self.opw {
             Some(_) => {
-                self.ik_closed_form(&target, seed, &IkOptions::default(), Variants::Nearest)?
+                let options = IkOptions::default();
+                if let Some(q) = self.nearest_exact(&target, seed, &options) {
+                    return Ok(q);
+                }
+                // None found this way: the full pass finds why (or the same answer).
+                self.ik_closed_form(&target, seed, &options, Variants::Nearest)?
             }
             None => {
                 let q = self
@@ -245,6 +250,45 @@ impl Robot {
             (got.translation.vector - target.translation.vector).norm(),
             got.rotation.angle_to(&target.rotation),
         )
+    }
+
+    /// `ik_closed_form`'s first answer with `Variants::Nearest`, checking candidates with FK
+    /// nearest first and stopping at the first exact one (one FK instead of up to eight on a
+    /// path sampled densely). Filtering and sorting commute, so it is the same answer; `None`
+    /// when there is none, for the full pass to say why.
+    fn nearest_exact(
+        &self,
+        target: &Isometry3<f64>,
+        seed: &[f64; 6],
+        options: &IkOptions,
+    ) -> Option<[f64; 6]> {
+        let opw = self.opw.as_ref()?;
+        let raw = opw.solve(target, seed[3]);
+        let limits: [(f64, f64); 6] = std::array::from_fn(|i| {
+            let j = &self.joints[self.active[i]];
+            (j.lower, j.upper)
+        });
+        let mut nearest: Vec<([f64; 6], f64)> = Vec::with_capacity(8);
+        // (distance to the seed, generation order, raw candidate) as `ik_closed_form` sorts.
+        let mut keys: Vec<(f64, usize, usize)> = Vec::with_capacity(8);
+        for k in 0..raw.count {
+            let t5 = raw.wrist_angles[k];
+            let wrist = t5.abs().min(PI - t5.abs());
+            let before = nearest.len();
+            push_nearest_variant(&raw.candidates[k], &limits, wrist, seed, &mut nearest);
+            if nearest.len() > before && wrist >= options.wrist_margin {
+                let q = &nearest[before].0;
+                let dist: f64 = q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum();
+                keys.push((dist, before, k));
+            }
+        }
+        keys.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        keys.into_iter()
+            .find(|&(_, _, k)| {
+                let (dp, dr) = self.residual(&raw.candidates[k], target);
+                dp <= options.position_tolerance && dr <= options.rotation_tolerance
+            })
+            .map(|(_, i, _)| nearest[i].0)
     }
 
     /// Closed-form IK on fixed-size arrays (no allocation per candidate).
