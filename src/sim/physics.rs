@@ -133,6 +133,9 @@ pub struct Physics {
     /// The joints and held piece `place_robot` last put the robot's bodies at, until
     /// anything else may have moved them (a step, a drive, a carry, a change to the world).
     placed: Option<RobotPlacement>,
+    /// Where `place_robot` was last asked to put them, not done yet: the bodies move when
+    /// something may look at them (`flush`), not every tick of a quiet run.
+    pending: Option<RobotPlacement>,
     /// Where `advance_rides` last put each rider, unrounded.
     ride_exact: HashMap<RigidBodyHandle, Vector3<f64>>,
 }
@@ -401,6 +404,7 @@ impl Physics {
             disturbances: 0,
             riding: BTreeMap::new(),
             placed: None,
+            pending: None,
             ride_exact: HashMap::new(),
         }
     }
@@ -546,6 +550,11 @@ impl Physics {
     }
 
     pub fn lumber_pose(&self, id: &str) -> Option<Isometry3<f64>> {
+        if let Some((held, pose)) = self.pending_held()
+            && held == id
+        {
+            return Some(pose);
+        }
         let b = self.lumber.get(id)?;
         Some(to_iso(self.world.bodies[b.body].position()))
     }
@@ -563,12 +572,15 @@ impl Physics {
     /// Moves the robot's base (its carriage on a linear track); the links follow at the
     /// next drive or placement.
     pub fn set_robot_base(&mut self, base: nalgebra::Isometry3<f64>) {
+        self.flush();
         self.placed = None;
         self.cell.robot_base = base;
     }
 
     /// Moves the robot's bodies to joint values `q` by the end of the next step.
     pub fn drive_robot(&mut self, q: &[f64]) {
+        // The step moves the bodies from where they stand now.
+        self.flush();
         self.placed = None;
         let poses = self.cell.robot.fk_all(q);
         for &(i, body) in &self.links {
@@ -660,6 +672,7 @@ impl Physics {
 
     /// Moves a held piece with the tool by the end of the next step.
     pub fn carry(&mut self, id: &str, pose: &Isometry3<f64>) {
+        self.flush();
         self.placed = None;
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_next_kinematic_position(to_pose(pose));
@@ -730,6 +743,7 @@ impl Physics {
 
     /// One physics step.
     pub fn step(&mut self) {
+        self.flush();
         self.placed = None;
         self.world.step_with_events(&self.belts, &());
     }
@@ -745,6 +759,7 @@ impl Physics {
     }
 
     fn changed(&mut self, disturbs: bool) {
+        self.flush();
         self.placed = None;
         self.generation += 1;
         if disturbs {
@@ -753,36 +768,63 @@ impl Physics {
     }
 
     /// Puts the robot's bodies (and the held piece, at `in_tool` in tool0) at joint values
-    /// `q` at once, without a step: nothing is pushed and no velocity results.
+    /// `q` at once, without a step: nothing is pushed and no velocity results. The bodies
+    /// move when anything may see them (a step, a collision detection, a change to the
+    /// world, the held piece's pose asked for): a robot moving through a quiet world is
+    /// placed once per look, not once per tick. What is seen is the same.
     pub fn place_robot(&mut self, q: &[f64], held: Option<(&str, &Isometry3<f64>)>) {
         // A robot standing still (waiting for a piece) is where the last placement left it.
         let same = |p: &RobotPlacement| {
             p.q.as_slice() == q && p.held.as_ref().map(|(id, g)| (id.as_str(), g)) == held
         };
-        if self.placed.as_ref().is_some_and(same) {
+        if self
+            .pending
+            .as_ref()
+            .or(self.placed.as_ref())
+            .is_some_and(same)
+        {
             return;
         }
-        self.placed = Some(RobotPlacement {
+        self.pending = Some(RobotPlacement {
             q: q.to_vec(),
             held: held.map(|(id, g)| (id.to_string(), *g)),
         });
-        let poses = self.cell.robot.fk_all(q);
+    }
+
+    /// Moves the robot's bodies where `place_robot` was last asked to put them.
+    fn flush(&mut self) {
+        let Some(placement) = self.pending.take() else {
+            return;
+        };
+        let poses = self.cell.robot.fk_all(&placement.q);
         for &(i, body) in &self.links {
             let pose = to_pose(&(self.cell.robot_base * poses[i]));
             self.world.bodies[body].set_position(pose, false);
         }
-        let tool = self.cell.robot_base * self.cell.robot.fk_tip(q);
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(&placement.q);
         self.world.bodies[self.tool].set_position(to_pose(&tool), false);
-        if let Some((id, in_tool)) = held
+        if let Some((id, in_tool)) = &placement.held
             && let Some(b) = self.lumber.get(id)
         {
             self.world.bodies[b.body].set_position(to_pose(&(tool * in_tool)), false);
         }
+        self.placed = Some(placement);
+    }
+
+    /// The held piece's pose while its placement waits (see `place_robot`), as `flush` will
+    /// set it.
+    fn pending_held(&self) -> Option<(&str, Isometry3<f64>)> {
+        let placement = self.pending.as_ref()?;
+        let (id, in_tool) = placement.held.as_ref()?;
+        self.lumber.get(id)?;
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(&placement.q);
+        Some((id.as_str(), to_iso(&to_pose(&(tool * in_tool)))))
     }
 
     /// Updates the contacts for where the bodies are now, without advancing time (no solver,
     /// nothing moves).
     pub fn detect(&mut self) {
+        self.flush();
         self.world.detect_collisions(&self.belts, &());
     }
 
@@ -1042,9 +1084,13 @@ impl Physics {
 
     /// Current pose of every piece in the world, in id order, without copying the ids.
     pub fn lumber_poses_in_order(&self) -> Vec<(&str, Isometry3<f64>)> {
+        let held = self.pending_held();
         self.lumber
             .iter()
-            .map(|(id, b)| (id.as_str(), to_iso(self.world.bodies[b.body].position())))
+            .map(|(id, b)| match held {
+                Some((h, pose)) if h == id => (id.as_str(), pose),
+                _ => (id.as_str(), to_iso(self.world.bodies[b.body].position())),
+            })
             .collect()
     }
 }
@@ -1275,6 +1321,47 @@ mod tests {
             b.loose
         );
         assert!(b.loose < 100.0);
+    }
+
+    /// The robot's bodies move when looked at (`place_robot` is lazy): the held piece is seen
+    /// where the grip puts it on the tool at the last joints asked for, before and after the
+    /// bodies move, and the tool body stands at those joints afterwards.
+    #[test]
+    fn a_placement_is_seen_before_the_bodies_move_where_they_then_move() {
+        let cell = Cell::load("study-abb").expect("cell");
+        let mut phys = piece_on_running_belt(&cell, 1.0 / 240.0);
+        phys.attach("p");
+        let in_tool = Isometry3::translation(0.01, -0.02, 0.2);
+        let home = cell.robot.home();
+        let near = |a: &Isometry3<f64>, b: &Isometry3<f64>| {
+            (a.translation.vector - b.translation.vector).norm() < 1e-5
+                && a.rotation.angle_to(&b.rotation) < 1e-5
+        };
+        let mut last = None;
+        for k in 1..=5 {
+            let q: Vec<f64> = home
+                .iter()
+                .enumerate()
+                .map(|(j, v)| v + 0.01 * k as f64 * (j as f64 + 1.0))
+                .collect();
+            phys.place_robot(&q, Some(("p", &in_tool)));
+            let seen = phys.lumber_pose("p").expect("piece");
+            let tool = cell.robot_base * cell.robot.fk_tip(&q);
+            assert!(near(&seen, &(tool * in_tool)), "k = {k}");
+            assert_eq!(phys.lumber_poses_in_order()[0], ("p", seen));
+            last = Some((tool, seen));
+        }
+        let (tool, seen) = last.expect("placed");
+        phys.detect();
+        assert_eq!(
+            phys.lumber_pose("p"),
+            Some(seen),
+            "the body is where it was seen"
+        );
+        assert!(near(
+            &to_iso(phys.world.bodies[phys.tool].position()),
+            &tool
+        ));
     }
 
     #[test]
