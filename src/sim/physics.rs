@@ -785,10 +785,23 @@ impl Physics {
         {
             return;
         }
-        self.pending = Some(RobotPlacement {
-            q: q.to_vec(),
-            held: held.map(|(id, g)| (id.to_string(), *g)),
+        // Written over the waiting placement's buffers: no allocation per tick.
+        let p = self.pending.get_or_insert_with(|| RobotPlacement {
+            q: Vec::new(),
+            held: None,
         });
+        p.q.clear();
+        p.q.extend_from_slice(q);
+        match (held, &mut p.held) {
+            (Some((id, g)), Some((was, in_tool))) => {
+                if was != id {
+                    was.clear();
+                    was.push_str(id);
+                }
+                *in_tool = *g;
+            }
+            (held, slot) => *slot = held.map(|(id, g)| (id.to_string(), *g)),
+        }
     }
 
     /// Moves the robot's bodies where `place_robot` was last asked to put them.

@@ -74,6 +74,8 @@ struct Anchor {
     held: Option<String>,
     /// When it was measured (s): riders have moved since.
     t: f64,
+    /// Whether the robot touched something there.
+    touching: bool,
 }
 
 impl Events {
@@ -102,7 +104,8 @@ impl<'a> WallRun<'a> {
         let generation = self.phys.generation();
         let base = self.phys.robot_base();
         let held_id = self.held.as_ref().map(|h| h.id.as_str());
-        let within = self.events.anchor.as_ref().is_some_and(|a| {
+        // Whether the last measurement holds, and then whether the robot touches something.
+        let holds = self.events.anchor.as_ref().and_then(|a| {
             // The robot and a rider may close the gap from both sides.
             let ridden = self.phys.ride_speed() * (self.t - a.t + self.options.dt);
             let moved: f64 =
@@ -111,13 +114,20 @@ impl<'a> WallRun<'a> {
                     .zip(&a.levers)
                     .map(|((from, to), lever)| (to - from).abs() * lever)
                     .sum();
-            a.generation == generation
-                && a.held.as_deref() == held_id
-                && a.base == base
-                && moved + ridden < a.free
+            let same = a.generation == generation && a.held.as_deref() == held_id && a.base == base;
+            if !same {
+                None
+            } else if moved + ridden < a.free {
+                Some(false)
+            } else if moved + ridden == 0.0 && a.touching {
+                // Nothing has moved since it found a touch: it would find the same one.
+                Some(true)
+            } else {
+                None
+            }
         });
-        let mut touching = false;
-        if !within {
+        let mut touching = holds.unwrap_or(false);
+        if holds.is_none() {
             // Measured where the robot's bodies stand (the previous tick's joints).
             let at = self.events.prev_q.clone();
             let held = self.held.clone();
@@ -143,6 +153,7 @@ impl<'a> WallRun<'a> {
                 generation,
                 held: held_ref.map(|h| h.0.to_string()),
                 t: self.t,
+                touching,
             });
         }
         self.quiet_tick(touching);
