@@ -252,6 +252,14 @@ impl Robot {
         )
     }
 
+    /// The six moving joints' limits (closed form).
+    fn limits6(&self) -> [(f64, f64); 6] {
+        std::array::from_fn(|i| {
+            let j = &self.joints[self.active[i]];
+            (j.lower, j.upper)
+        })
+    }
+
     /// `ik_closed_form`'s first answer with `Variants::Nearest`, checking candidates with FK
     /// nearest first and stopping at the first exact one (one FK instead of up to eight on a
     /// path sampled densely). Filtering and sorting commute, so it is the same answer; `None`
@@ -264,22 +272,16 @@ impl Robot {
     ) -> Option<[f64; 6]> {
         let opw = self.opw.as_ref()?;
         let raw = opw.solve(target, seed[3]);
-        let limits: [(f64, f64); 6] = std::array::from_fn(|i| {
-            let j = &self.joints[self.active[i]];
-            (j.lower, j.upper)
-        });
+        let limits = self.limits6();
         let mut nearest: Vec<([f64; 6], f64)> = Vec::with_capacity(8);
         // (distance to the seed, generation order, raw candidate) as `ik_closed_form` sorts.
         let mut keys: Vec<(f64, usize, usize)> = Vec::with_capacity(8);
         for k in 0..raw.count {
-            let t5 = raw.wrist_angles[k];
-            let wrist = t5.abs().min(PI - t5.abs());
+            let wrist = wrist_clearance(raw.wrist_angles[k]);
             let before = nearest.len();
             push_nearest_variant(&raw.candidates[k], &limits, wrist, seed, &mut nearest);
             if nearest.len() > before && wrist >= options.wrist_margin {
-                let q = &nearest[before].0;
-                let dist: f64 = q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum();
-                keys.push((dist, before, k));
+                keys.push((seed_distance(&nearest[before].0, seed), before, k));
             }
         }
         keys.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -317,10 +319,7 @@ impl Robot {
                 min_reach,
             });
         }
-        let limits: [(f64, f64); 6] = std::array::from_fn(|i| {
-            let j = &self.joints[self.active[i]];
-            (j.lower, j.upper)
-        });
+        let limits = self.limits6();
         let mut within: Vec<([f64; 6], f64)> = Vec::with_capacity(32);
         // FK check only where it matters: candidates with copies inside the limits now, the
         // others only if nothing is left (to tell a joint limit from a numeric failure).
@@ -337,8 +336,7 @@ impl Robot {
         let mut best_residual = (f64::INFINITY, f64::INFINITY);
         for k in 0..raw.count {
             let cand = &raw.candidates[k];
-            let t5 = raw.wrist_angles[k];
-            let wrist = t5.abs().min(PI - t5.abs());
+            let wrist = wrist_clearance(raw.wrist_angles[k]);
             let before = within.len();
             match variants {
                 Variants::All => push_turn_variants(cand, &limits, wrist, &mut within),
@@ -395,11 +393,10 @@ impl Robot {
         }
         // Sort small (distance, index) keys, ties by generation order (deterministic), then
         // gather, dropping exact duplicates (equal distance, so adjacent).
-        let dist = |q: &[f64; 6]| -> f64 { q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum() };
         let mut keys: Vec<(f64, usize)> = within
             .iter()
             .enumerate()
-            .map(|(i, (q, _))| (dist(q), i))
+            .map(|(i, (q, _))| (seed_distance(q, seed), i))
             .collect();
         keys.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let mut out: Vec<[f64; 6]> = Vec::with_capacity(keys.len());
@@ -446,6 +443,16 @@ impl Robot {
             excess,
         }
     }
+}
+
+/// How far the wrist angle θ5 is from singular (from 0 and from π, rad).
+fn wrist_clearance(t5: f64) -> f64 {
+    t5.abs().min(PI - t5.abs())
+}
+
+/// Squared joint-space distance from `seed`, the order solutions are returned in.
+fn seed_distance(q: &[f64; 6], seed: &[f64]) -> f64 {
+    q.iter().zip(seed).map(|(a, b)| (a - b).powi(2)).sum()
 }
 
 /// Which whole-turn copies of a closed-form branch to keep.

@@ -22,7 +22,7 @@ use crate::frame::plan::Plan;
 use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, cell_facts, model_facts, reason};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
-use crate::world::{Scene, WorldError};
+use crate::world::{Scene, SceneWall, WorldError};
 use std::collections::BTreeSet;
 
 /// How to simulate.
@@ -231,10 +231,13 @@ fn run_walls(
     let plan = Plan::from_reasoned(model, &planned);
     let selected = select_walls(&plan, &options.walls)?;
 
-    let run_wall = |key: &String| -> Option<Result<WallRecord, SimError>> {
-        // The rules name a wall by its key piece; the scene does too.
-        let scene_wall = scene.walls.iter().find(|w| &w.id == key)?;
-        let plan_wall = plan.walls.iter().find(|w| &w.key == key)?;
+    // The rules name a wall by its key piece; the scene does too.
+    let walls: Vec<&SceneWall> = selected
+        .iter()
+        .filter_map(|key| scene.walls.iter().find(|w| &w.id == key))
+        .collect();
+    let run_wall = |scene_wall: &&SceneWall| -> Option<Result<WallRecord, SimError>> {
+        let plan_wall = plan.walls.iter().find(|w| w.key == scene_wall.id)?;
         let pieces = scene_wall
             .pieces
             .iter()
@@ -251,14 +254,7 @@ fn run_walls(
             reached,
         }))
     };
-    let cost = |key: &String| {
-        scene
-            .walls
-            .iter()
-            .find(|w| &w.id == key)
-            .map_or(0, |w| w.pieces.len())
-    };
-    let records = largest_first(&selected, cost, run_wall)
+    let records = largest_first(&walls, |w| w.pieces.len(), run_wall)
         .into_iter()
         .flatten()
         .collect::<Result<Vec<WallRecord>, SimError>>()?;

@@ -572,16 +572,14 @@ impl Physics {
     /// Moves the robot's base (its carriage on a linear track); the links follow at the
     /// next drive or placement.
     pub fn set_robot_base(&mut self, base: nalgebra::Isometry3<f64>) {
-        self.flush();
-        self.placed = None;
+        self.bodies_may_move();
         self.cell.robot_base = base;
     }
 
     /// Moves the robot's bodies to joint values `q` by the end of the next step.
     pub fn drive_robot(&mut self, q: &[f64]) {
         // The step moves the bodies from where they stand now.
-        self.flush();
-        self.placed = None;
+        self.bodies_may_move();
         let poses = self.cell.robot.fk_all(q);
         for &(i, body) in &self.links {
             let pose = to_pose(&(self.cell.robot_base * poses[i]));
@@ -672,8 +670,7 @@ impl Physics {
 
     /// Moves a held piece with the tool by the end of the next step.
     pub fn carry(&mut self, id: &str, pose: &Isometry3<f64>) {
-        self.flush();
-        self.placed = None;
+        self.bodies_may_move();
         if let Some(b) = self.lumber.get(id) {
             self.world.bodies[b.body].set_next_kinematic_position(to_pose(pose));
         }
@@ -743,8 +740,7 @@ impl Physics {
 
     /// One physics step.
     pub fn step(&mut self) {
-        self.flush();
-        self.placed = None;
+        self.bodies_may_move();
         self.world.step_with_events(&self.belts, &());
     }
 
@@ -759,8 +755,7 @@ impl Physics {
     }
 
     fn changed(&mut self, disturbs: bool) {
-        self.flush();
-        self.placed = None;
+        self.bodies_may_move();
         self.generation += 1;
         if disturbs {
             self.disturbances += 1;
@@ -802,6 +797,13 @@ impl Physics {
             }
             (held, slot) => *slot = held.map(|(id, g)| (id.to_string(), *g)),
         }
+    }
+
+    /// Before anything that may move the robot's bodies or look at them: they stand where
+    /// `place_robot` was last asked to put them, and the next placement places them again.
+    fn bodies_may_move(&mut self) {
+        self.flush();
+        self.placed = None;
     }
 
     /// Moves the robot's bodies where `place_robot` was last asked to put them.
