@@ -147,6 +147,44 @@ struct RobotPlacement {
     held: Option<(String, Isometry3<f64>)>,
 }
 
+/// Which bodies that cannot move a clearance's `any` distance measures (lumber that can move is
+/// always measured: the robot may push it).
+#[derive(Debug, Clone, Copy)]
+pub enum Watch<'a> {
+    /// Every body but these pieces (lumber ids; none: every body).
+    AllBut(&'a [&'a str]),
+    /// None: the caller records no touch.
+    Nothing,
+}
+
+impl Watch<'_> {
+    fn counts(&self, piece: Option<&String>) -> bool {
+        match self {
+            Watch::AllBut(ids) => !piece.is_some_and(|id| ids.contains(&id.as_str())),
+            Watch::Nothing => false,
+        }
+    }
+}
+
+/// The robot's moving shapes at some joint values (see `Physics::probe`).
+#[derive(Debug, Clone)]
+pub struct Probe {
+    shapes: Vec<(ColliderHandle, Isometry3<f64>)>,
+    /// Per moving joint: its index in the joint values, kind and a point of its axis.
+    axes: Vec<(usize, JointKind, Vector3<f64>)>,
+    dofs: usize,
+    /// The robot's bodies and the held piece's, which a clearance leaves out.
+    own: Vec<RigidBodyHandle>,
+    riders: Vec<LumberBody>,
+}
+
+impl Probe {
+    /// How many shapes it holds.
+    pub fn shape_count(&self) -> usize {
+        self.shapes.len()
+    }
+}
+
 /// How far the robot, its tool and a held piece are from the rest of the world (m), each
 /// capped at the reach asked for.
 #[derive(Debug, Clone, Copy)]
@@ -889,52 +927,54 @@ impl Physics {
         shapes
     }
 
-    /// Corners of the local bounding boxes of the robot's moving colliders and the held piece
-    /// at joint values `q`: no point of them moves further than the furthest-moving corner
-    /// (a rigid motion moves a box's points at most as far as its furthest corner).
-    pub fn robot_corners(
-        &self,
-        q: &[f64],
-        held: Option<(&str, &Isometry3<f64>)>,
-    ) -> Vec<Vector3<f64>> {
-        let mut corners = Vec::new();
-        for (c, pose) in self.robot_shapes_at(q, held) {
-            let aabb = self.world.colliders[c].shape().compute_local_aabb();
-            let (lo, hi) = (aabb.mins, aabb.maxs);
-            for k in 0..8 {
-                let pick = |bit: usize, a: f32, b: f32| f64::from(if k & bit == 0 { a } else { b });
-                let local = nalgebra::Point3::new(
-                    pick(1, lo.x, hi.x),
-                    pick(2, lo.y, hi.y),
-                    pick(4, lo.z, hi.z),
-                );
-                corners.push((pose * local).coords);
-            }
+    /// The robot's moving shapes (its colliders, base link excluded, and the held piece's) and
+    /// its joints' axes at joint values `q`, for measuring each shape's clearance apart.
+    pub fn probe(&self, q: &[f64], held: Option<(&str, &Isometry3<f64>)>) -> Probe {
+        let poses = self.cell.robot.fk_all(q);
+        let axes = self
+            .cell
+            .robot
+            .joints
+            .iter()
+            .filter_map(|joint| {
+                let i = joint.dof_index?;
+                // The child frame's origin lies on the joint's axis.
+                let origin = (self.cell.robot_base * poses[joint.child])
+                    .translation
+                    .vector;
+                Some((i, joint.kind, origin))
+            })
+            .collect();
+        let mut own: Vec<RigidBodyHandle> = self.links.iter().map(|l| l.1).collect();
+        own.push(self.tool);
+        if let Some(b) = held.and_then(|(id, _)| self.lumber.get(id)) {
+            own.push(b.body);
         }
-        corners
+        Probe {
+            shapes: self.robot_shapes_at(q, held),
+            axes,
+            dofs: q.len(),
+            own,
+            // Riders are measured apart, where they are now: between steps the broad phase
+            // holds them where the last step left them.
+            riders: self.riding.values().copied().collect(),
+        }
     }
 
-    /// Per joint of `q`, a bound on how far any of `corners` (cell frame, at joint values `q`)
-    /// moves per unit of that joint's motion while they all move less than `slack` (m): for a
-    /// revolute joint the corners' largest distance from a point of its axis plus `slack` (m
-    /// per rad), for a prismatic one 1. Summed over |Δq|, it bounds every corner's motion
-    /// without forward kinematics.
-    pub fn robot_levers(&self, q: &[f64], corners: &[Vector3<f64>], slack: f64) -> Vec<f64> {
-        let robot = &self.cell.robot;
-        let poses = robot.fk_all(q);
-        let mut levers = vec![0.0; q.len()];
-        for joint in &robot.joints {
-            let Some(i) = joint.dof_index else {
-                continue;
-            };
-            levers[i] = match joint.kind {
+    /// Per joint, a bound on how far any point of the probe's shape `i` moves per unit of
+    /// that joint's motion while it moves less than `slack` (m): for a revolute joint the
+    /// largest distance of its bounding box's corners from a point of the axis plus `slack`
+    /// (m per rad; a rigid motion moves a box's points at most as far as its furthest
+    /// corner), for a prismatic one 1. Summed over |Δq|, it bounds the shape's motion without
+    /// forward kinematics.
+    pub fn levers(&self, probe: &Probe, i: usize, slack: f64) -> Vec<f64> {
+        let corners = self.shape_corners(probe, i);
+        let mut levers = vec![0.0; probe.dofs];
+        for &(i, kind, origin) in &probe.axes {
+            levers[i] = match kind {
                 JointKind::Prismatic => 1.0,
                 JointKind::Fixed => 0.0,
                 JointKind::Revolute | JointKind::Continuous => {
-                    // The child frame's origin lies on the joint's axis.
-                    let origin = (self.cell.robot_base * poses[joint.child])
-                        .translation
-                        .vector;
                     let far = corners
                         .iter()
                         .map(|c| (c - origin).norm())
@@ -951,22 +991,53 @@ impl Physics {
         self.cell.robot_base
     }
 
-    /// How far the robot, its tool and the held piece at joint values `q` are from everything
-    /// else they can touch, and from loose lumber; distances beyond `reach` read as `reach`.
+    /// The corners of the local bounding box of the probe's shape `i`, in the cell frame.
+    fn shape_corners(&self, probe: &Probe, i: usize) -> [Vector3<f64>; 8] {
+        let (c, pose) = &probe.shapes[i];
+        let aabb = self.world.colliders[*c].shape().compute_local_aabb();
+        let (lo, hi) = (aabb.mins, aabb.maxs);
+        std::array::from_fn(|k| {
+            let pick = |bit: usize, a: f32, b: f32| f64::from(if k & bit == 0 { a } else { b });
+            let local = nalgebra::Point3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            );
+            (pose * local).coords
+        })
+    }
+
+    /// How far the robot, its tool and the held piece at joint values `q` are from what they
+    /// can touch that `watch` names or that can move (`any`), and from loose lumber;
+    /// distances beyond `reach` read as `reach`. (The executor measures shape by shape.)
+    #[cfg(test)]
     pub fn clearance(
         &self,
         q: &[f64],
         held: Option<(&str, &Isometry3<f64>)>,
         reach: f64,
+        watch: Watch,
     ) -> Clearance {
-        let mut own: Vec<RigidBodyHandle> = self.links.iter().map(|l| l.1).collect();
-        own.push(self.tool);
-        if let Some(b) = held.and_then(|(id, _)| self.lumber.get(id)) {
-            own.push(b.body);
-        }
-        // Riders are measured apart, where they are now: between steps the broad phase holds
-        // them where the last step left them.
-        let riders: Vec<LumberBody> = self.riding.values().copied().collect();
+        let probe = self.probe(q, held);
+        (0..probe.shape_count())
+            .map(|i| self.shape_clearance(&probe, i, reach, watch))
+            .fold(
+                Clearance {
+                    any: reach,
+                    loose: reach,
+                    parked: reach,
+                },
+                |a, b| Clearance {
+                    any: a.any.min(b.any),
+                    loose: a.loose.min(b.loose),
+                    parked: a.parked.min(b.parked),
+                },
+            )
+    }
+
+    /// `clearance` of the probe's shape `i` alone.
+    pub fn shape_clearance(&self, probe: &Probe, i: usize, reach: f64, watch: Watch) -> Clearance {
+        let (own, riders) = (&probe.own, &probe.riders);
         let predicate = |_: ColliderHandle, c: &Collider| {
             !c.is_sensor()
                 && !c
@@ -978,55 +1049,57 @@ impl Physics {
             loose: reach,
             parked: reach,
         };
-        for (c, pose) in self.robot_shapes_at(q, held) {
-            let collider = &self.world.colliders[c];
-            let shape = collider.shape();
-            let pose = to_pose(&pose);
-            let (grown, centre) = grown_box(shape, reach);
-            let filter = QueryFilter::default()
-                .groups(collider.collision_groups())
-                .predicate(&predicate);
-            for (_, other) in self.world.intersect_shape(pose * centre, &grown, filter) {
-                let Ok(d) =
-                    rapier3d::parry::query::distance(&pose, shape, other.position(), other.shape())
-                else {
-                    // A pair parry cannot measure counts as touching.
-                    found.any = 0.0;
-                    found.loose = 0.0;
-                    continue;
-                };
-                let d = f64::from(d.distance);
-                found.any = found.any.min(d);
-                let loose = other
-                    .parent()
-                    .is_some_and(|b| self.world.bodies[b].is_dynamic());
-                if loose {
-                    found.loose = found.loose.min(d);
-                }
+        let (c, pose) = probe.shapes[i];
+        let collider = &self.world.colliders[c];
+        let shape = collider.shape();
+        let pose = to_pose(&pose);
+        let (grown, centre) = grown_box(shape, reach);
+        let filter = QueryFilter::default()
+            .groups(collider.collision_groups())
+            .predicate(&predicate);
+        for (h, other) in self.world.intersect_shape(pose * centre, &grown, filter) {
+            let loose = other
+                .parent()
+                .is_some_and(|b| self.world.bodies[b].is_dynamic());
+            if !loose && !watch.counts(self.lumber_of.get(&h)) {
+                continue;
             }
-            // A rider moves on its own: it counts as loose.
-            let reach_box = shape.compute_aabb(&pose).loosened(reach as f32);
-            for r in &riders {
-                if !collider
-                    .collision_groups()
-                    .test(self.world.colliders[r.collider].collision_groups())
-                {
-                    continue;
-                }
-                let other = &self.world.colliders[r.collider];
-                let at = *self.world.bodies[r.body].position()
-                    * *other.position_wrt_parent().unwrap_or(&Pose::IDENTITY);
-                // Farther than `reach` changes nothing (distances are capped at it).
-                if !reach_box.intersects(&other.shape().compute_aabb(&at)) {
-                    continue;
-                }
-                let d = rapier3d::parry::query::distance(&pose, shape, &at, other.shape())
-                    .map_or(0.0, |d| f64::from(d.distance).min(reach));
-                found.any = found.any.min(d);
+            let Ok(d) =
+                rapier3d::parry::query::distance(&pose, shape, other.position(), other.shape())
+            else {
+                // A pair parry cannot measure counts as touching.
+                found.any = 0.0;
+                found.loose = 0.0;
+                continue;
+            };
+            let d = f64::from(d.distance);
+            found.any = found.any.min(d);
+            if loose {
                 found.loose = found.loose.min(d);
-                if !self.belts.running {
-                    found.parked = found.parked.min(d);
-                }
+            }
+        }
+        // A rider moves on its own: it counts as loose.
+        let reach_box = shape.compute_aabb(&pose).loosened(reach as f32);
+        for r in riders.iter() {
+            if !collider
+                .collision_groups()
+                .test(self.world.colliders[r.collider].collision_groups())
+            {
+                continue;
+            }
+            let other = &self.world.colliders[r.collider];
+            let at = *self.world.bodies[r.body].position()
+                * *other.position_wrt_parent().unwrap_or(&Pose::IDENTITY);
+            // Farther than `reach` changes nothing (distances are capped at it).
+            if !reach_box.intersects(&other.shape().compute_aabb(&at)) {
+                continue;
+            }
+            let d = rapier3d::parry::query::distance(&pose, shape, &at, other.shape())
+                .map_or(0.0, |d| f64::from(d.distance).min(reach));
+            found.any = found.any.min(d);
+            found.loose = found.loose.min(d);
+            if !self.belts.running {
+                found.parked = found.parked.min(d);
             }
         }
         found
@@ -1245,7 +1318,7 @@ mod tests {
         }
         assert_eq!(phys.lumber_pose("p").expect("piece"), parked_at);
         // The robot's clearance sees it as parked lumber.
-        let clear = phys.clearance(&cell.robot.home(), None, 100.0);
+        let clear = phys.clearance(&cell.robot.home(), None, 100.0, Watch::AllBut(&[]));
         assert!(clear.parked < 100.0 && clear.parked >= clear.loose);
         // Starting the belts leaves it as stopping them without parking does: dynamic, at rest.
         phys.set_belts(true, false);
@@ -1271,7 +1344,8 @@ mod tests {
             "unparking changes the world"
         );
         assert_eq!(
-            phys.clearance(&cell.robot.home(), None, 100.0).parked,
+            phys.clearance(&cell.robot.home(), None, 100.0, Watch::AllBut(&[]))
+                .parked,
             100.0
         );
         // A standing belt carries nothing: no ride starts on it.
@@ -1325,7 +1399,7 @@ mod tests {
         // The rider counts as loose where it is now, not where the broad phase last saw it:
         // its distance to the robot at home equals that of a world stepped to the same place.
         let home = cell.robot.home();
-        let measured = |phys: &Physics| phys.clearance(&home, None, 100.0);
+        let measured = |phys: &Physics| phys.clearance(&home, None, 100.0, Watch::AllBut(&[]));
         let (a, b) = (measured(&ride(false)), measured(&advanced_world));
         // (within the stepped ride's rounding; the broad phase's stale place is the whole
         // ride, 0.1 m, away)
@@ -1380,41 +1454,43 @@ mod tests {
     }
 
     #[test]
-    fn joint_levers_bound_how_far_every_corner_moves() {
+    fn joint_levers_bound_how_far_every_corner_of_each_shape_moves() {
         for name in ["study-abb", "study-kuka"] {
             let cell = Cell::load(name).expect("cell");
             let phys = Physics::new(&cell, &cell.robot.home(), 1.0 / 240.0);
             let home = cell.robot.home();
-            let corners = phys.robot_corners(&home, None);
+            let at_home = phys.probe(&home, None);
             let slack = 0.10;
-            let levers = phys.robot_levers(&home, &corners, slack);
             let mut checked = 0;
-            // Small moves of every joint together, both ways: each corner moves no further
-            // than the bound while the bound stays under the slack.
-            for k in 0..200 {
-                let dq: Vec<f64> = (0..home.len())
-                    .map(|j| 0.004 * (((k * 7 + j * 3) % 11) as f64 - 5.0) / 5.0)
-                    .collect();
-                let q: Vec<f64> = home.iter().zip(&dq).map(|(a, d)| a + d).collect();
-                let bound: f64 = dq.iter().zip(&levers).map(|(d, l)| d.abs() * l).sum();
-                if bound >= slack {
-                    continue;
+            for i in 0..at_home.shape_count() {
+                let corners = phys.shape_corners(&at_home, i);
+                let levers = phys.levers(&at_home, i, slack);
+                // Small moves of every joint together, both ways: each corner moves no
+                // further than the bound while the bound stays under the slack.
+                for k in 0..200 {
+                    let dq: Vec<f64> = (0..home.len())
+                        .map(|j| 0.004 * (((k * 7 + j * 3) % 11) as f64 - 5.0) / 5.0)
+                        .collect();
+                    let q: Vec<f64> = home.iter().zip(&dq).map(|(a, d)| a + d).collect();
+                    let bound: f64 = dq.iter().zip(&levers).map(|(d, l)| d.abs() * l).sum();
+                    if bound >= slack {
+                        continue;
+                    }
+                    let moved = phys
+                        .shape_corners(&phys.probe(&q, None), i)
+                        .iter()
+                        .zip(&corners)
+                        .map(|(a, b)| (a - b).norm())
+                        .fold(0.0, f64::max);
+                    assert!(
+                        moved <= bound + 1e-9,
+                        "{name} shape {i}: moved {moved} > bound {bound}"
+                    );
+                    checked += 1;
                 }
-                let moved = phys
-                    .robot_corners(&q, None)
-                    .iter()
-                    .zip(&corners)
-                    .map(|(a, b)| (a - b).norm())
-                    .fold(0.0, f64::max);
-                assert!(
-                    moved <= bound + 1e-9,
-                    "{name}: moved {moved} > bound {bound}"
-                );
-                assert!(moved > 0.0);
-                checked += 1;
             }
             assert!(
-                checked > 100,
+                checked > 100 * at_home.shape_count(),
                 "{name}: only {checked} moves within the slack"
             );
         }

@@ -17,6 +17,7 @@
 
 use super::WallRun;
 use crate::sim::Stepping;
+use crate::sim::physics::Watch;
 use nalgebra::Isometry3;
 
 /// Lumber slower than this is at rest (m/s, rad/s).
@@ -38,7 +39,7 @@ const CALM_STEPS: u32 = 30;
 const LOOSE_MARGIN: f64 = 2.0 * TOUCH;
 /// How far a clearance measurement looks (m): the robot moves this far less LOOSE_MARGIN
 /// before the next one when nothing is near.
-const CLEARANCE_REACH: f64 = 0.10;
+const CLEARANCE_REACH: f64 = 0.20;
 /// Closer than this the robot may be touching something (m).
 const TOUCH: f64 = 1e-4;
 
@@ -59,22 +60,60 @@ pub(super) struct Events {
     all_ride: Option<((u64, usize), bool)>,
 }
 
+/// The last clearance measurements, while the world, the held piece, the robot's base and
+/// the bodies left out stay as they were.
 #[derive(Debug, Clone)]
 struct Anchor {
-    /// The joints and the base it was measured at, and per joint how far the robot's
-    /// corners move per unit of its motion at most (`Physics::robot_levers`).
-    q: Vec<f64>,
     base: Isometry3<f64>,
-    levers: Vec<f64>,
-    /// How far the corners may move before something could be touched or loose lumber
-    /// come within LOOSE_MARGIN (m).
-    free: f64,
     generation: u64,
     held: Option<String>,
+    /// The bodies the robot may touch unrecorded then (`watched`): the measurements left
+    /// them out.
+    watched: Option<Vec<String>>,
+    /// Per shape of the robot (`Physics::probe`), its last measurement.
+    shapes: Vec<ShapeAnchor>,
+}
+
+/// One shape's clearance measurement. Each shape is measured again only when it may have
+/// used up its own clearance: a held piece sliding along what it is set against is measured
+/// every tick, the arm's other shapes far from everything seldom.
+#[derive(Debug, Clone)]
+struct ShapeAnchor {
+    /// The joints it was measured at, and per joint how far the shape's points move per unit
+    /// of its motion at most (`Physics::levers`).
+    q: Vec<f64>,
+    levers: Vec<f64>,
+    /// How far the shape may move before it could touch something or come within
+    /// LOOSE_MARGIN of loose lumber (m).
+    free: f64,
     /// When it was measured (s): riders have moved since.
     t: f64,
-    /// Whether the robot touched something there.
+    /// Whether it touched something there.
     touching: bool,
+}
+
+impl ShapeAnchor {
+    /// Some(touching) while the measurement holds at joints `q` and time `t`: it is not
+    /// touching anything if it moved less than its clearance, and touches what it touched
+    /// if nothing moved at all. None: measure again.
+    fn holds(&self, q: &[f64], t: f64, ride_speed: f64) -> Option<bool> {
+        // The shape and a rider may close the gap from both sides.
+        let ridden = ride_speed * (t - self.t);
+        let moved: f64 = self
+            .q
+            .iter()
+            .zip(q)
+            .zip(&self.levers)
+            .map(|((from, to), lever)| (to - from).abs() * lever)
+            .sum();
+        if moved + ridden < self.free {
+            Some(false)
+        } else if moved + ridden == 0.0 && self.touching {
+            Some(true)
+        } else {
+            None
+        }
+    }
 }
 
 impl Events {
@@ -103,57 +142,83 @@ impl<'a> WallRun<'a> {
         let generation = self.phys.generation();
         let base = self.phys.robot_base();
         let held_id = self.held.as_ref().map(|h| h.id.as_str());
-        // Whether the last measurement holds, and then whether the robot touches something.
-        let holds = self.events.anchor.as_ref().and_then(|a| {
-            // The robot and a rider may close the gap from both sides.
-            let ridden = self.phys.ride_speed() * (self.t - a.t + self.options.dt);
-            let moved: f64 =
-                a.q.iter()
-                    .zip(&self.events.prev_q)
-                    .zip(&a.levers)
-                    .map(|((from, to), lever)| (to - from).abs() * lever)
-                    .sum();
-            let same = a.generation == generation && a.held.as_deref() == held_id && a.base == base;
-            if !same {
-                None
-            } else if moved + ridden < a.free {
-                Some(false)
-            } else if moved + ridden == 0.0 && a.touching {
-                // Nothing has moved since it found a touch: it would find the same one.
-                Some(true)
-            } else {
-                None
-            }
-        });
-        let mut touching = holds.unwrap_or(false);
-        if holds.is_none() {
-            // Measured where the robot's bodies stand (the previous tick's joints).
-            let at = self.events.prev_q.clone();
-            let held = self.held.clone();
-            let held_ref = held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
-            let clear = self.phys.clearance(&at, held_ref, CLEARANCE_REACH);
-            if clear.loose < LOOSE_MARGIN {
-                self.events.anchor = None;
-                if clear.parked < LOOSE_MARGIN {
-                    // The robot may push parked lumber: it is dynamic again, as unparked.
-                    self.phys.unpark();
+        let watched = watched(&self.current);
+        if self.events.anchor.as_ref().is_some_and(|a| {
+            a.generation != generation
+                || a.held.as_deref() != held_id
+                || a.base != base
+                || a.watched.as_deref() != watched
+        }) {
+            self.events.anchor = None;
+        }
+        // Measured where the robot's bodies stand (the previous tick's joints).
+        let at = &self.events.prev_q;
+        let t = self.t + self.options.dt;
+        let ride_speed = self.phys.ride_speed();
+        let mut touching = false;
+        // The shapes to measure again: all of them without a measurement that holds.
+        let mut stale = None;
+        if let Some(a) = &self.events.anchor {
+            let mut expired = Vec::new();
+            for (i, shape) in a.shapes.iter().enumerate() {
+                match shape.holds(at, t, ride_speed) {
+                    Some(touch) => touching |= touch,
+                    None => expired.push(i),
                 }
-                self.solver_tick();
-                return;
             }
-            touching = clear.any <= TOUCH;
-            let free = clear.any.min(clear.loose - LOOSE_MARGIN);
-            let corners = self.phys.robot_corners(&at, held_ref);
-            self.events.anchor = Some(Anchor {
-                levers: self.phys.robot_levers(&at, &corners, free),
-                q: at,
+            stale = Some(expired);
+        }
+        if stale.as_ref().is_none_or(|s| !s.is_empty()) {
+            let held = self.held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
+            let probe = self.phys.probe(at, held);
+            let stale = stale.unwrap_or_else(|| (0..probe.shape_count()).collect());
+            let ignored: Vec<&str> = watched
+                .unwrap_or_default()
+                .iter()
+                .filter_map(|name| name.strip_prefix("piece "))
+                .collect();
+            let watch = match watched {
+                Some(_) => Watch::AllBut(&ignored),
+                None => Watch::Nothing,
+            };
+            let mut measured = Vec::with_capacity(stale.len());
+            for &i in &stale {
+                let clear = self.phys.shape_clearance(&probe, i, CLEARANCE_REACH, watch);
+                if clear.loose < LOOSE_MARGIN {
+                    // The robot may push loose lumber: the solver steps.
+                    self.events.anchor = None;
+                    if clear.parked < LOOSE_MARGIN {
+                        // Parked lumber is dynamic again, as unparked.
+                        self.phys.unpark();
+                    }
+                    self.solver_tick();
+                    return;
+                }
+                measured.push((i, clear));
+            }
+            let anchor = self.events.anchor.get_or_insert_with(|| Anchor {
                 base,
-                free,
                 generation,
-                held: held_ref.map(|h| h.0.to_string()),
-                t: self.t,
-                touching,
+                held: held_id.map(str::to_string),
+                watched: watched.map(<[String]>::to_vec),
+                shapes: Vec::new(),
             });
+            for (i, clear) in measured {
+                let free = clear.any.min(clear.loose - LOOSE_MARGIN);
+                let shape = ShapeAnchor {
+                    levers: self.phys.levers(&probe, i, free),
+                    q: at.clone(),
+                    free,
+                    t: self.t,
+                    touching: clear.any <= TOUCH,
+                };
+                touching |= shape.touching;
+                if i < anchor.shapes.len() {
+                    anchor.shapes[i] = shape;
+                } else {
+                    anchor.shapes.push(shape);
+                }
+            }
         }
         self.quiet_tick(touching);
     }
@@ -204,8 +269,7 @@ impl<'a> WallRun<'a> {
     /// them (at `self.q`), for whatever the executor does next (grip, release, measure).
     fn quiet_tick(&mut self, touching: bool) {
         let held_ref = self.held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
-        // Contacts are recorded in operations other than waiting for a piece (as `step`).
-        let watched = matches!(&self.current, Some((_, op, _)) if *op != "feed");
+        let watched = watched(&self.current).is_some();
         if touching && watched {
             self.phys.place_robot(&self.events.prev_q, held_ref);
             self.phys.detect();
@@ -233,5 +297,15 @@ impl<'a> WallRun<'a> {
         let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
         let lumber = self.phys.lumber_poses_in_order();
         self.record.trace.sample(self.t, &self.q, tool, &lumber);
+    }
+}
+/// The bodies (`piece <id>` names) whose touches the current operation does not record, if it
+/// records any: contacts are recorded in operations other than waiting for a piece (as
+/// `step`). A clearance measurement leaves out those that cannot move: touching them changes
+/// nothing until the operation changes.
+fn watched<'c>(current: &'c Option<(String, &'static str, Vec<String>)>) -> Option<&'c [String]> {
+    match current {
+        Some((_, op, allowed)) if *op != "feed" => Some(allowed),
+        _ => None,
     }
 }
