@@ -147,21 +147,32 @@ struct RobotPlacement {
     held: Option<(String, Isometry3<f64>)>,
 }
 
-/// Which bodies that cannot move a clearance's `any` distance measures (lumber that can move is
-/// always measured: the robot may push it).
+/// Which touches a caller records: a clearance's `any` measures how far the robot is from
+/// the first of them (lumber that can move is always measured: the robot may push it).
 #[derive(Debug, Clone, Copy)]
 pub enum Watch<'a> {
-    /// Every body but these pieces (lumber ids; none: every body).
-    AllBut(&'a [&'a str]),
-    /// None: the caller records no touch.
+    /// Touches of anything but these pieces (lumber ids); those of the held piece with
+    /// anything and of the robot with what is not lumber only deeper than `tolerance` (m),
+    /// those of the robot with lumber at any depth.
+    AllBut {
+        pieces: &'a [&'a str],
+        tolerance: f64,
+    },
+    /// None.
     Nothing,
 }
 
 impl Watch<'_> {
-    fn counts(&self, piece: Option<&String>) -> bool {
+    /// How deep a touch between a robot shape (`held`: the held piece) and a body (`piece`:
+    /// the lumber it is) goes unrecorded; None: it is never recorded.
+    fn unrecorded_depth(&self, held: bool, piece: Option<&String>) -> Option<f64> {
         match self {
-            Watch::AllBut(ids) => !piece.is_some_and(|id| ids.contains(&id.as_str())),
-            Watch::Nothing => false,
+            Watch::AllBut { pieces, tolerance } => match piece {
+                Some(id) if pieces.contains(&id.as_str()) => None,
+                Some(_) if !held => Some(0.0),
+                _ => Some(*tolerance),
+            },
+            Watch::Nothing => None,
         }
     }
 }
@@ -175,6 +186,8 @@ pub struct Probe {
     dofs: usize,
     /// The robot's bodies and the held piece's, which a clearance leaves out.
     own: Vec<RigidBodyHandle>,
+    /// The held piece's collider.
+    held: Option<ColliderHandle>,
     riders: Vec<LumberBody>,
 }
 
@@ -189,7 +202,9 @@ impl Probe {
 /// capped at the reach asked for.
 #[derive(Debug, Clone, Copy)]
 pub struct Clearance {
-    /// To anything they can touch (fixed bodies, clamped and loose lumber).
+    /// To a touch the caller records (`Watch`): the distance to it plus how deep it may go
+    /// unrecorded, and for a touch already deeper than 0 that depth less the touch's
+    /// (0 or less: touching).
     pub any: f64,
     /// To lumber that can move (dynamic bodies).
     pub loose: f64,
@@ -951,6 +966,9 @@ impl Physics {
             own.push(b.body);
         }
         Probe {
+            held: held
+                .and_then(|(id, _)| self.lumber.get(id))
+                .map(|b| b.collider),
             shapes: self.robot_shapes_at(q, held),
             axes,
             dofs: q.len(),
@@ -1057,23 +1075,35 @@ impl Physics {
         let filter = QueryFilter::default()
             .groups(collider.collision_groups())
             .predicate(&predicate);
+        let held = probe.held == Some(c);
         for (h, other) in self.world.intersect_shape(pose * centre, &grown, filter) {
             let loose = other
                 .parent()
                 .is_some_and(|b| self.world.bodies[b].is_dynamic());
-            if !loose && !watch.counts(self.lumber_of.get(&h)) {
+            let unrecorded = watch.unrecorded_depth(held, self.lumber_of.get(&h));
+            if !loose && unrecorded.is_none() {
                 continue;
             }
-            let Ok(d) =
-                rapier3d::parry::query::distance(&pose, shape, other.position(), other.shape())
-            else {
+            let (at, other_shape) = (other.position(), other.shape());
+            let Ok(d) = rapier3d::parry::query::distance(&pose, shape, at, other_shape) else {
                 // A pair parry cannot measure counts as touching.
                 found.any = 0.0;
                 found.loose = 0.0;
                 continue;
             };
             let d = f64::from(d.distance);
-            found.any = found.any.min(d);
+            // How far from a recorded touch: a touch shallower than `unrecorded` is not one.
+            let to_record = match unrecorded {
+                Some(depth) if depth > 0.0 && d <= 0.0 => {
+                    rapier3d::parry::query::contact(&pose, shape, at, other_shape, 0.0)
+                        .ok()
+                        .flatten()
+                        .map_or(0.0, |contact| depth + f64::from(contact.dist))
+                }
+                Some(depth) => d + depth,
+                None => d,
+            };
+            found.any = found.any.min(to_record);
             if loose {
                 found.loose = found.loose.min(d);
             }
@@ -1318,7 +1348,15 @@ mod tests {
         }
         assert_eq!(phys.lumber_pose("p").expect("piece"), parked_at);
         // The robot's clearance sees it as parked lumber.
-        let clear = phys.clearance(&cell.robot.home(), None, 100.0, Watch::AllBut(&[]));
+        let clear = phys.clearance(
+            &cell.robot.home(),
+            None,
+            100.0,
+            Watch::AllBut {
+                pieces: &[],
+                tolerance: 0.0,
+            },
+        );
         assert!(clear.parked < 100.0 && clear.parked >= clear.loose);
         // Starting the belts leaves it as stopping them without parking does: dynamic, at rest.
         phys.set_belts(true, false);
@@ -1344,8 +1382,16 @@ mod tests {
             "unparking changes the world"
         );
         assert_eq!(
-            phys.clearance(&cell.robot.home(), None, 100.0, Watch::AllBut(&[]))
-                .parked,
+            phys.clearance(
+                &cell.robot.home(),
+                None,
+                100.0,
+                Watch::AllBut {
+                    pieces: &[],
+                    tolerance: 0.0
+                }
+            )
+            .parked,
             100.0
         );
         // A standing belt carries nothing: no ride starts on it.
@@ -1399,7 +1445,17 @@ mod tests {
         // The rider counts as loose where it is now, not where the broad phase last saw it:
         // its distance to the robot at home equals that of a world stepped to the same place.
         let home = cell.robot.home();
-        let measured = |phys: &Physics| phys.clearance(&home, None, 100.0, Watch::AllBut(&[]));
+        let measured = |phys: &Physics| {
+            phys.clearance(
+                &home,
+                None,
+                100.0,
+                Watch::AllBut {
+                    pieces: &[],
+                    tolerance: 0.0,
+                },
+            )
+        };
         let (a, b) = (measured(&ride(false)), measured(&advanced_world));
         // (within the stepped ride's rounding; the broad phase's stale place is the whole
         // ride, 0.1 m, away)
@@ -1451,6 +1507,46 @@ mod tests {
             &to_iso(phys.world.bodies[phys.tool].position()),
             &tool
         ));
+    }
+
+    /// How far the held piece is from a recorded touch when it lies `gap` from a clamped piece
+    /// end to end (negative: pressed that deep into it), leaving out the pieces `ignored`.
+    fn held_piece_to_record(gap: f64, ignored: &[&str]) -> f64 {
+        let cell = Cell::load("study-abb").expect("cell");
+        let home = cell.robot.home();
+        let mut phys = Physics::new(&cell, &home, 1.0 / 240.0);
+        let (mut piece, _) = piece_on_deck(&cell);
+        let in_tool = Isometry3::translation(0.0, 0.0, 0.3);
+        let held_at = cell.robot_base * cell.robot.fk_tip(&home) * in_tool;
+        phys.add_lumber(&piece, &held_at);
+        piece.id = "w".into();
+        let beside = held_at * Isometry3::translation(piece.size[0] + gap, 0.0, 0.0);
+        phys.add_lumber(&piece, &beside);
+        phys.attach("p");
+        phys.clamp("w");
+        phys.place_robot(&home, Some(("p", &in_tool)));
+        phys.detect();
+        let probe = phys.probe(&home, Some(("p", &in_tool)));
+        let held = (0..probe.shape_count())
+            .find(|&i| Some(probe.shapes[i].0) == probe.held)
+            .expect("the held piece is a shape");
+        let watch = Watch::AllBut {
+            pieces: ignored,
+            tolerance: 0.001,
+        };
+        phys.shape_clearance(&probe, held, 0.1, watch).any
+    }
+
+    #[test]
+    fn a_held_piece_is_a_recorded_touch_only_deeper_than_the_tolerance() {
+        // Apart: the gap plus the depth that goes unrecorded.
+        assert!((held_piece_to_record(0.003, &[]) - 0.004).abs() < 1e-5);
+        // Pressed in less than the tolerance: not yet a recorded touch.
+        assert!((held_piece_to_record(-0.0005, &[]) - 0.0005).abs() < 1e-5);
+        // Deeper: recorded, by how much.
+        assert!((held_piece_to_record(-0.002, &[]) + 0.001).abs() < 1e-5);
+        // A piece the operation may touch is left out.
+        assert!(held_piece_to_record(-0.002, &["w"]) > 0.05);
     }
 
     #[test]

@@ -15,7 +15,7 @@
 //! runs (no time passes) and the contacts are recorded as a fixed-step run records them.
 //! Touching loose lumber (within LOOSE_MARGIN) the solver steps: the robot may push it.
 
-use super::WallRun;
+use super::{CONTACT_TOLERANCE, WallRun};
 use crate::sim::Stepping;
 use crate::sim::physics::Watch;
 use nalgebra::Isometry3;
@@ -42,6 +42,10 @@ const LOOSE_MARGIN: f64 = 2.0 * TOUCH;
 const CLEARANCE_REACH: f64 = 0.20;
 /// Closer than this the robot may be touching something (m).
 const TOUCH: f64 = 1e-4;
+/// How deep the held piece may press into anything, and the robot into what is not lumber,
+/// before the contact could be recorded (CONTACT_TOLERANCE deep): a measurement (parry's
+/// penetration depth) and the recorded depth (rapier's contact manifold) may differ a little.
+const UNRECORDED: f64 = CONTACT_TOLERANCE - 2.0 * TOUCH;
 
 /// What event-driven stepping keeps between ticks.
 #[derive(Debug, Clone)]
@@ -178,7 +182,10 @@ impl<'a> WallRun<'a> {
                 .filter_map(|name| name.strip_prefix("piece "))
                 .collect();
             let watch = match watched {
-                Some(_) => Watch::AllBut(&ignored),
+                Some(_) => Watch::AllBut {
+                    pieces: &ignored,
+                    tolerance: UNRECORDED,
+                },
                 None => Watch::Nothing,
             };
             let mut measured = Vec::with_capacity(stale.len());
@@ -206,7 +213,7 @@ impl<'a> WallRun<'a> {
             for (i, clear) in measured {
                 let free = clear.any.min(clear.loose - LOOSE_MARGIN);
                 let shape = ShapeAnchor {
-                    levers: self.phys.levers(&probe, i, free),
+                    levers: self.phys.levers(&probe, i, free.max(0.0)),
                     q: at.clone(),
                     free,
                     t: self.t,
