@@ -212,7 +212,6 @@ fn a_tool_table_in_the_arm_s_path_is_never_driven_through() {
 }
 
 #[test]
-#[ignore = "on main since the planner and event-driven stepping merged, the KUKA bottom plate at 0.70 m fails on joint a3 and the top plate's place descent touches a stud: under investigation (closing note)"]
 fn the_arm_does_not_knock_lumber_off_the_belt_on_its_way_to_a_pick() {
     // On the KUKA cell the tool swung low over conveyor 2 on its way above a stud and a jaw
     // grazed it (0.2 mm), knocking it over: moves now keep a margin from everything.
