@@ -896,6 +896,13 @@ impl Physics {
         self.world.detect_collisions(&self.belts, &());
     }
 
+    /// Whether some piece is a dynamic body (not held, clamped, riding or parked).
+    pub fn any_dynamic_lumber(&self) -> bool {
+        self.lumber
+            .values()
+            .any(|b| self.world.bodies[b.body].is_dynamic())
+    }
+
     /// Whether every dynamic lumber body moves slower than `linear` (m/s) and `angular` (rad/s).
     pub fn lumber_calm(&self, linear: f64, angular: f64) -> bool {
         self.lumber.values().all(|b| {

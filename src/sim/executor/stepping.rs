@@ -6,9 +6,10 @@
 //! joints follow their motion profile tick by tick as before, the pose trace is sampled at
 //! its rate, and the robot's contacts are found where a fixed-step run would find them.
 //!
-//! Contacts without the solver: the distances from the robot, its tool and the held piece to
-//! everything else are measured at a pose; no point of them comes closer than that until
-//! they have moved that far, so nothing more is measured until then. How far they have moved
+//! Contacts without the solver: the distance from each of the robot's shapes (links, tool
+//! parts, the held piece) to a touch that would be recorded is measured at a pose; no point
+//! of that shape comes closer than that until it has moved that far, so that shape is not
+//! measured again until then. How far they have moved
 //! is bounded without forward kinematics: per joint, |Δq| times the largest distance from its
 //! axis to a corner of their bounding boxes (a rotation by θ moves a point at distance r at
 //! most θ·r). Where they touch something, rapier's collision detection
@@ -62,6 +63,8 @@ pub(super) struct Events {
     /// `all_on_belts_ride`'s last answer and the (world change count, pieces on the belts)
     /// it was found at.
     all_ride: Option<((u64, usize), bool)>,
+    /// `any_loose_lumber`'s last answer and the world change count it was found at.
+    loose_lumber: Option<(u64, bool)>,
 }
 
 /// The last clearance measurements, while the world, the held piece, the robot's base and
@@ -128,6 +131,7 @@ impl Events {
             prev_q: q.to_vec(),
             anchor: None,
             all_ride: None,
+            loose_lumber: None,
         }
     }
 }
@@ -235,9 +239,31 @@ impl<'a> WallRun<'a> {
     /// contacts), and every other piece at rest for CALM_STEPS solver steps since the last
     /// change.
     fn world_quiet(&mut self) -> bool {
-        (!self.phys.belts.running || self.all_on_belts_ride())
-            && self.events.disturbances == self.phys.disturbances()
-            && self.events.calm_steps >= CALM_STEPS
+        if self.phys.belts.running && !self.all_on_belts_ride() {
+            return false;
+        }
+        if !self.any_loose_lumber() {
+            // Nothing can move on its own (every piece held, clamped, riding or parked):
+            // after a change there is nothing to settle.
+            self.events.disturbances = self.phys.disturbances();
+            self.events.calm_steps = CALM_STEPS;
+            return true;
+        }
+        self.events.disturbances == self.phys.disturbances() && self.events.calm_steps >= CALM_STEPS
+    }
+
+    /// Whether some piece is a dynamic body. A piece changes kind only with a change to the
+    /// world: the answer holds while the world's change count stays.
+    fn any_loose_lumber(&mut self) -> bool {
+        let generation = self.phys.generation();
+        if let Some((seen, answer)) = self.events.loose_lumber
+            && seen == generation
+        {
+            return answer;
+        }
+        let answer = self.phys.any_dynamic_lumber();
+        self.events.loose_lumber = Some((generation, answer));
+        answer
     }
 
     /// Whether every piece on the belts rides them. Rides start and end, and pieces come onto
