@@ -151,11 +151,11 @@ struct RobotPlacement {
 /// the first of them (lumber that can move is always measured: the robot may push it).
 #[derive(Debug, Clone, Copy)]
 pub enum Watch<'a> {
-    /// Touches of anything but these pieces (lumber ids); those of the held piece with
-    /// anything and of the robot with what is not lumber only deeper than `tolerance` (m),
-    /// those of the robot with lumber at any depth.
+    /// Touches of anything but these bodies (by name, as `name` gives them); those of the
+    /// held piece with anything and of the robot with what is not lumber only deeper than
+    /// `tolerance` (m), those of the robot with lumber at any depth.
     AllBut {
-        pieces: &'a [&'a str],
+        bodies: &'a [String],
         tolerance: f64,
     },
     /// None.
@@ -163,15 +163,13 @@ pub enum Watch<'a> {
 }
 
 impl Watch<'_> {
-    /// How deep a touch between a robot shape (`held`: the held piece) and a body (`piece`:
-    /// the lumber it is) goes unrecorded; None: it is never recorded.
-    fn unrecorded_depth(&self, held: bool, piece: Option<&String>) -> Option<f64> {
+    /// How deep a touch between a robot shape (`held`: the held piece) and a body (`name`,
+    /// `lumber`: whether it is a piece) goes unrecorded; None: it is never recorded.
+    fn unrecorded_depth(&self, held: bool, name: Option<&String>, lumber: bool) -> Option<f64> {
         match self {
-            Watch::AllBut { pieces, tolerance } => match piece {
-                Some(id) if pieces.contains(&id.as_str()) => None,
-                Some(_) if !held => Some(0.0),
-                _ => Some(*tolerance),
-            },
+            Watch::AllBut { bodies, .. } if name.is_some_and(|n| bodies.contains(n)) => None,
+            Watch::AllBut { .. } if lumber && !held => Some(0.0),
+            Watch::AllBut { tolerance, .. } => Some(*tolerance),
             Watch::Nothing => None,
         }
     }
@@ -967,15 +965,12 @@ impl Physics {
                 Some((i, joint.kind, origin))
             })
             .collect();
+        let held_body = held.and_then(|(id, _)| self.lumber.get(id));
         let mut own: Vec<RigidBodyHandle> = self.links.iter().map(|l| l.1).collect();
         own.push(self.tool);
-        if let Some(b) = held.and_then(|(id, _)| self.lumber.get(id)) {
-            own.push(b.body);
-        }
+        own.extend(held_body.map(|b| b.body));
         Probe {
-            held: held
-                .and_then(|(id, _)| self.lumber.get(id))
-                .map(|b| b.collider),
+            held: held_body.map(|b| b.collider),
             shapes: self.robot_shapes_at(q, held),
             axes,
             dofs: q.len(),
@@ -1087,7 +1082,8 @@ impl Physics {
             let loose = other
                 .parent()
                 .is_some_and(|b| self.world.bodies[b].is_dynamic());
-            let unrecorded = watch.unrecorded_depth(held, self.lumber_of.get(&h));
+            let lumber = self.lumber_of.contains_key(&h);
+            let unrecorded = watch.unrecorded_depth(held, self.names.get(&h), lumber);
             if !loose && unrecorded.is_none() {
                 continue;
             }
@@ -1355,15 +1351,7 @@ mod tests {
         }
         assert_eq!(phys.lumber_pose("p").expect("piece"), parked_at);
         // The robot's clearance sees it as parked lumber.
-        let clear = phys.clearance(
-            &cell.robot.home(),
-            None,
-            100.0,
-            Watch::AllBut {
-                pieces: &[],
-                tolerance: 0.0,
-            },
-        );
+        let clear = phys.clearance(&cell.robot.home(), None, 100.0, EVERY_TOUCH);
         assert!(clear.parked < 100.0 && clear.parked >= clear.loose);
         // Starting the belts leaves it as stopping them without parking does: dynamic, at rest.
         phys.set_belts(true, false);
@@ -1389,16 +1377,8 @@ mod tests {
             "unparking changes the world"
         );
         assert_eq!(
-            phys.clearance(
-                &cell.robot.home(),
-                None,
-                100.0,
-                Watch::AllBut {
-                    pieces: &[],
-                    tolerance: 0.0
-                }
-            )
-            .parked,
+            phys.clearance(&cell.robot.home(), None, 100.0, EVERY_TOUCH)
+                .parked,
             100.0
         );
         // A standing belt carries nothing: no ride starts on it.
@@ -1452,17 +1432,7 @@ mod tests {
         // The rider counts as loose where it is now, not where the broad phase last saw it:
         // its distance to the robot at home equals that of a world stepped to the same place.
         let home = cell.robot.home();
-        let measured = |phys: &Physics| {
-            phys.clearance(
-                &home,
-                None,
-                100.0,
-                Watch::AllBut {
-                    pieces: &[],
-                    tolerance: 0.0,
-                },
-            )
-        };
+        let measured = |phys: &Physics| phys.clearance(&home, None, 100.0, EVERY_TOUCH);
         let (a, b) = (measured(&ride(false)), measured(&advanced_world));
         // (within the stepped ride's rounding; the broad phase's stale place is the whole
         // ride, 0.1 m, away)
@@ -1516,9 +1486,15 @@ mod tests {
         ));
     }
 
+    /// Every touch, at any depth.
+    const EVERY_TOUCH: Watch = Watch::AllBut {
+        bodies: &[],
+        tolerance: 0.0,
+    };
+
     /// How far the held piece is from a recorded touch when it lies `gap` from a clamped piece
     /// end to end (negative: pressed that deep into it), leaving out the pieces `ignored`.
-    fn held_piece_to_record(gap: f64, ignored: &[&str]) -> f64 {
+    fn held_piece_to_record(gap: f64, ignored: &[String]) -> f64 {
         let cell = Cell::load("study-abb").expect("cell");
         let home = cell.robot.home();
         let mut phys = Physics::new(&cell, &home, 1.0 / 240.0);
@@ -1538,7 +1514,7 @@ mod tests {
             .find(|&i| Some(probe.shapes[i].0) == probe.held)
             .expect("the held piece is a shape");
         let watch = Watch::AllBut {
-            pieces: ignored,
+            bodies: ignored,
             tolerance: 0.001,
         };
         phys.shape_clearance(&probe, held, 0.1, watch).any
@@ -1553,7 +1529,7 @@ mod tests {
         // Deeper: recorded, by how much.
         assert!((held_piece_to_record(-0.002, &[]) + 0.001).abs() < 1e-5);
         // A piece the operation may touch is left out.
-        assert!(held_piece_to_record(-0.002, &["w"]) > 0.05);
+        assert!(held_piece_to_record(-0.002, &["piece w".to_string()]) > 0.05);
     }
 
     #[test]
@@ -1568,6 +1544,7 @@ mod tests {
             for i in 0..at_home.shape_count() {
                 let corners = phys.shape_corners(&at_home, i);
                 let levers = phys.levers(&at_home, i, slack);
+                let mut farthest: f64 = 0.0;
                 // Small moves of every joint together, both ways: each corner moves no
                 // further than the bound while the bound stays under the slack.
                 for k in 0..200 {
@@ -1589,8 +1566,11 @@ mod tests {
                         moved <= bound + 1e-9,
                         "{name} shape {i}: moved {moved} > bound {bound}"
                     );
+                    farthest = farthest.max(moved);
                     checked += 1;
                 }
+                // The moves move every shape (the bound is not checked on a standstill).
+                assert!(farthest > 0.0, "{name} shape {i} never moved");
             }
             assert!(
                 checked > 100 * at_home.shape_count(),

@@ -177,61 +177,74 @@ impl<'a> WallRun<'a> {
             stale = Some(expired);
         }
         if stale.as_ref().is_none_or(|s| !s.is_empty()) {
-            let held = self.held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
-            let probe = self.phys.probe(at, held);
-            let stale = stale.unwrap_or_else(|| (0..probe.shape_count()).collect());
-            let ignored: Vec<&str> = watched
-                .unwrap_or_default()
-                .iter()
-                .filter_map(|name| name.strip_prefix("piece "))
-                .collect();
-            let watch = match watched {
-                Some(_) => Watch::AllBut {
-                    pieces: &ignored,
-                    tolerance: UNRECORDED,
-                },
-                None => Watch::Nothing,
-            };
-            let mut measured = Vec::with_capacity(stale.len());
-            for &i in &stale {
-                let clear = self.phys.shape_clearance(&probe, i, CLEARANCE_REACH, watch);
-                if clear.loose < LOOSE_MARGIN {
-                    // The robot may push loose lumber: the solver steps.
-                    self.events.anchor = None;
-                    if clear.parked < LOOSE_MARGIN {
-                        // Parked lumber is dynamic again, as unparked.
-                        self.phys.unpark();
-                    }
-                    self.solver_tick();
-                    return;
-                }
-                measured.push((i, clear));
-            }
-            let anchor = self.events.anchor.get_or_insert_with(|| Anchor {
-                base,
-                generation,
-                held: held_id.map(str::to_string),
-                watched: watched.map(<[String]>::to_vec),
-                shapes: Vec::new(),
-            });
-            for (i, clear) in measured {
-                let free = clear.any.min(clear.loose - LOOSE_MARGIN);
-                let shape = ShapeAnchor {
-                    levers: self.phys.levers(&probe, i, free.max(0.0)),
-                    q: at.clone(),
-                    free,
-                    t: self.t,
-                    touching: clear.any <= TOUCH,
-                };
-                touching |= shape.touching;
-                if i < anchor.shapes.len() {
-                    anchor.shapes[i] = shape;
-                } else {
-                    anchor.shapes.push(shape);
-                }
+            match self.measure_clearances(stale) {
+                Some(touch) => touching |= touch,
+                // Near loose lumber: the solver stepped.
+                None => return,
             }
         }
         self.quiet_tick(touching);
+    }
+
+    /// Measures the robot's shapes `stale` (all of them: None) where its bodies stand (the
+    /// previous tick's joints) and keeps the measurements. Some(whether one touches
+    /// something); None: one is near loose lumber, and the solver stepped instead.
+    fn measure_clearances(&mut self, stale: Option<Vec<usize>>) -> Option<bool> {
+        let generation = self.phys.generation();
+        let base = self.phys.robot_base();
+        let held_id = self.held.as_ref().map(|h| h.id.as_str());
+        let watched = watched(&self.current);
+        let mut touching = false;
+        let held = self.held.as_ref().map(|h| (h.id.as_str(), &h.in_tool));
+        let at = self.events.prev_q.clone();
+        let probe = self.phys.probe(&at, held);
+        let stale = stale.unwrap_or_else(|| (0..probe.shape_count()).collect());
+        let watch = match watched {
+            Some(bodies) => Watch::AllBut {
+                bodies,
+                tolerance: UNRECORDED,
+            },
+            None => Watch::Nothing,
+        };
+        let mut measured = Vec::with_capacity(stale.len());
+        for &i in &stale {
+            let clear = self.phys.shape_clearance(&probe, i, CLEARANCE_REACH, watch);
+            if clear.loose < LOOSE_MARGIN {
+                // The robot may push loose lumber: the solver steps.
+                self.events.anchor = None;
+                if clear.parked < LOOSE_MARGIN {
+                    // Parked lumber is dynamic again, as unparked.
+                    self.phys.unpark();
+                }
+                self.solver_tick();
+                return None;
+            }
+            measured.push((i, clear));
+        }
+        let anchor = self.events.anchor.get_or_insert_with(|| Anchor {
+            base,
+            generation,
+            held: held_id.map(str::to_string),
+            watched: watched.map(<[String]>::to_vec),
+            shapes: Vec::new(),
+        });
+        for (i, clear) in measured {
+            let free = clear.any.min(clear.loose - LOOSE_MARGIN);
+            let shape = ShapeAnchor {
+                levers: self.phys.levers(&probe, i, free.max(0.0)),
+                q: at.clone(),
+                free,
+                t: self.t,
+                touching: clear.any <= TOUCH,
+            };
+            touching |= shape.touching;
+            if i < anchor.shapes.len() {
+                anchor.shapes[i] = shape;
+            } else {
+                anchor.shapes.push(shape);
+            }
+        }
+        Some(touching)
     }
 
     /// Whether nothing in the world moves unless the robot pushes it, or rides a belt: the
