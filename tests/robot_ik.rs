@@ -382,3 +382,60 @@ fn ik_closest_is_the_first_of_all_solutions() {
         );
     }
 }
+
+/// Whether two lists of link poses (`Robot::fk_all`) are one arm shape: whole turns of a
+/// joint give the same.
+fn same_shape(a: &[Isometry3<f64>], b: &[Isometry3<f64>]) -> bool {
+    a.iter().zip(b).all(|(x, y)| {
+        let (dp, dr) = pose_error(x, y);
+        dp < 1e-9 && dr < 1e-9
+    })
+}
+
+#[test]
+fn ik_branches_are_the_arm_shapes_of_all_solutions() {
+    for name in ROBOTS {
+        let robot = Robot::load(name).unwrap();
+        // Wrist joints' ranges exceed a turn: `ik` gives whole-turn copies `ik_branches` drops.
+        let limits = robot.limits();
+        let mut rng = Lcg(4242);
+        let tcp = Isometry3::translation(0.0, 0.1, 0.3);
+        let mut copies_dropped = 0;
+        for k in 0..2000 {
+            let q = rng.joints(&limits);
+            let mut pose = robot.fk_tip(&q) * tcp;
+            if k % 7 == 6 {
+                pose.translation.vector *= 1.5;
+            }
+            let seed = rng.joints(&limits);
+            match (
+                robot.ik(&pose, &tcp, &seed),
+                robot.ik_branches(&pose, &tcp, &seed),
+            ) {
+                (Ok(all), Ok(branches)) => {
+                    assert!(
+                        branches.len() <= 8,
+                        "{name} #{k}: {} branches",
+                        branches.len()
+                    );
+                    let all: Vec<_> = all.iter().map(|s| robot.fk_all(s)).collect();
+                    let branches: Vec<_> = branches.iter().map(|s| robot.fk_all(s)).collect();
+                    // Each solution's shape is a branch's, and each branch is a solution's.
+                    for (i, s) in all.iter().enumerate() {
+                        assert!(
+                            branches.iter().any(|b| same_shape(s, b)),
+                            "{name} #{k}: solution {i} has no branch"
+                        );
+                    }
+                    for b in &branches {
+                        assert!(all.iter().any(|s| same_shape(s, b)), "{name} #{k}");
+                    }
+                    copies_dropped += all.len() - branches.len();
+                }
+                (Err(_), Err(_)) => {}
+                (a, b) => panic!("{name} #{k}: ik {a:?} but ik_branches {b:?}"),
+            }
+        }
+        assert!(copies_dropped > 0, "{name}: no whole-turn copies to drop");
+    }
+}

@@ -152,6 +152,28 @@ impl Robot {
         }
     }
 
+    /// One solution per closed-form branch (of each, the whole-turn copy nearest `seed`),
+    /// closest to `seed` first: `ik` without the copies that differ only by whole turns of a
+    /// joint, which leave the arm's shape as it is (what a question about the arm's shape,
+    /// such as how low it reaches, needs). Robots without a closed form: `ik`.
+    pub fn ik_branches(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64],
+    ) -> Result<Vec<Vec<f64>>, IkFailure> {
+        if self.opw.is_none() {
+            return self.ik(pose, tcp, seed);
+        }
+        assert_eq!(seed.len(), self.dof(), "seed length");
+        let target = tip_target(pose, tcp)?;
+        Ok(self
+            .ik_closed_form(&target, seed, &IkOptions::default(), Variants::Nearest)?
+            .into_iter()
+            .map(|q| q.to_vec())
+            .collect())
+    }
+
     /// How far (m) the wrist centre for this TCP pose is inside the arm's reach from the shoulder
     /// (negative: out of reach). `None` for robots without a closed form.
     pub fn reach_margin(&self, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) -> Option<f64> {

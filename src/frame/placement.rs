@@ -388,11 +388,11 @@ fn reached_together(cell: &Cell, poses: &[Isometry3<f64>], tcp: &Isometry3<f64>)
 }
 
 /// Whether some exact IK solution of a robot-frame TCP pose keeps the arm and its tool above
-/// the floor.
+/// the floor (one solution per branch: whole turns of a joint do not move the arm).
 fn solves_above_floor(cell: &Cell, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) -> bool {
     let floor = cell.floor.z - cell.robot_base.translation.z + FLOOR_CLEARANCE;
     cell.robot
-        .ik(pose, tcp, &cell.robot.home())
+        .ik_branches(pose, tcp, &cell.robot.home())
         .is_ok_and(|solutions| {
             solutions
                 .iter()

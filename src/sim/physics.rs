@@ -912,14 +912,14 @@ impl Physics {
     }
 
     /// The robot's colliders (base link excluded: it never moves) and the held piece's, with
-    /// their cell-frame poses at joint values `q`.
+    /// their cell-frame poses, given every link's pose (`Robot::fk_all`, robot frame) and the
+    /// tool's (cell frame) at some joint values.
     fn robot_shapes_at(
         &self,
-        q: &[f64],
+        poses: &[Isometry3<f64>],
+        tool: &Isometry3<f64>,
         held: Option<(&str, &Isometry3<f64>)>,
     ) -> Vec<(ColliderHandle, Isometry3<f64>)> {
-        let poses = self.cell.robot.fk_all(q);
-        let tool = self.cell.robot_base * self.cell.robot.fk_tip(q);
         let mut shapes = Vec::with_capacity(self.robot_colliders.len() + 1);
         for &c in &self.robot_colliders {
             let collider = &self.world.colliders[c];
@@ -927,7 +927,7 @@ impl Physics {
                 continue;
             };
             let body = if parent == self.tool {
-                tool
+                *tool
             } else {
                 match self.links.iter().find(|l| l.1 == parent) {
                     Some(&(0, _)) | None => continue,
@@ -951,6 +951,7 @@ impl Physics {
     /// its joints' axes at joint values `q`, for measuring each shape's clearance apart.
     pub fn probe(&self, q: &[f64], held: Option<(&str, &Isometry3<f64>)>) -> Probe {
         let poses = self.cell.robot.fk_all(q);
+        let tool = self.cell.robot_base * self.cell.robot.fk_tip(q);
         let axes = self
             .cell
             .robot
@@ -971,7 +972,7 @@ impl Physics {
         own.extend(held_body.map(|b| b.body));
         Probe {
             held: held_body.map(|b| b.collider),
-            shapes: self.robot_shapes_at(q, held),
+            shapes: self.robot_shapes_at(&poses, &tool, held),
             axes,
             dofs: q.len(),
             own,
