@@ -113,6 +113,8 @@ pub struct Physics {
     fingers: Vec<Finger>,
     /// Every collider of the robot and its tool.
     pub robot_colliders: Vec<ColliderHandle>,
+    /// The robot's colliders that move (not the base link's) and the body each belongs to.
+    moving_shapes: Vec<(ColliderHandle, ShapeOwner)>,
     pub sensor: ColliderHandle,
     pub lumber: BTreeMap<String, LumberBody>,
     /// Body names for contact reports.
@@ -175,24 +177,36 @@ impl Watch<'_> {
     }
 }
 
-/// The robot's moving shapes at some joint values (see `Physics::probe`).
+/// The body a robot collider belongs to: a link (by index) or the tool.
+#[derive(Debug, Clone, Copy)]
+enum ShapeOwner {
+    Link(usize),
+    Tool,
+}
+
+/// The robot's moving shapes at some joint values (see `Physics::probe`): the poses of the
+/// bodies they belong to, each shape's own pose worked out only when it is measured.
 #[derive(Debug, Clone)]
 pub struct Probe {
-    shapes: Vec<(ColliderHandle, Isometry3<f64>)>,
+    /// Every link's cell-frame pose, and the tool's.
+    links: Vec<Isometry3<f64>>,
+    tool: Isometry3<f64>,
     /// Per moving joint: its index in the joint values, kind and a point of its axis.
     axes: Vec<(usize, JointKind, Vector3<f64>)>,
     dofs: usize,
     /// The robot's bodies and the held piece's, which a clearance leaves out.
     own: Vec<RigidBodyHandle>,
-    /// The held piece's collider.
-    held: Option<ColliderHandle>,
+    /// The held piece's collider and its pose in tool0: the last shape.
+    held: Option<(ColliderHandle, Isometry3<f64>)>,
+    /// How many shapes: the robot's moving colliders, then the held piece.
+    count: usize,
     riders: Vec<LumberBody>,
 }
 
 impl Probe {
     /// How many shapes it holds.
     pub fn shape_count(&self) -> usize {
-        self.shapes.len()
+        self.count
     }
 }
 
@@ -436,6 +450,19 @@ impl Physics {
             }
         }
 
+        let moving_shapes = robot_colliders
+            .iter()
+            .filter_map(|&c| {
+                let parent = world.colliders[c].parent()?;
+                if parent == tool {
+                    return Some((c, ShapeOwner::Tool));
+                }
+                match links.iter().find(|l| l.1 == parent) {
+                    Some(&(0, _)) | None => None,
+                    Some(&(i, _)) => Some((c, ShapeOwner::Link(i))),
+                }
+            })
+            .collect();
         Physics {
             world,
             belts: Belts {
@@ -446,6 +473,7 @@ impl Physics {
             tool,
             fingers,
             robot_colliders,
+            moving_shapes,
             sensor,
             lumber: BTreeMap::new(),
             names,
@@ -911,46 +939,37 @@ impl Physics {
         })
     }
 
-    /// The robot's colliders (base link excluded: it never moves) and the held piece's, with
-    /// their cell-frame poses, given every link's pose (`Robot::fk_all`, robot frame) and the
-    /// tool's (cell frame) at some joint values.
-    fn robot_shapes_at(
-        &self,
-        poses: &[Isometry3<f64>],
-        tool: &Isometry3<f64>,
-        held: Option<(&str, &Isometry3<f64>)>,
-    ) -> Vec<(ColliderHandle, Isometry3<f64>)> {
-        let mut shapes = Vec::with_capacity(self.robot_colliders.len() + 1);
-        for &c in &self.robot_colliders {
-            let collider = &self.world.colliders[c];
-            let Some(parent) = collider.parent() else {
-                continue;
-            };
-            let body = if parent == self.tool {
-                *tool
-            } else {
-                match self.links.iter().find(|l| l.1 == parent) {
-                    Some(&(0, _)) | None => continue,
-                    Some(&(i, _)) => self.cell.robot_base * poses[i],
-                }
-            };
-            let local = collider
-                .position_wrt_parent()
-                .map_or_else(Isometry3::identity, to_iso);
-            shapes.push((c, body * local));
+    /// The probe's shape `i` (the robot's moving colliders, then the held piece) and its
+    /// cell-frame pose.
+    fn probe_shape(&self, probe: &Probe, i: usize) -> (ColliderHandle, Isometry3<f64>) {
+        match self.moving_shapes.get(i) {
+            Some(&(c, owner)) => {
+                let body = match owner {
+                    ShapeOwner::Tool => probe.tool,
+                    ShapeOwner::Link(link) => probe.links[link],
+                };
+                let local = self.world.colliders[c]
+                    .position_wrt_parent()
+                    .map_or_else(Isometry3::identity, to_iso);
+                (c, body * local)
+            }
+            None => {
+                let (c, in_tool) = probe.held.expect("a shape of the probe");
+                (c, probe.tool * in_tool)
+            }
         }
-        if let Some((id, in_tool)) = held
-            && let Some(b) = self.lumber.get(id)
-        {
-            shapes.push((b.collider, tool * in_tool));
-        }
-        shapes
     }
 
     /// The robot's moving shapes (its colliders, base link excluded, and the held piece's) and
     /// its joints' axes at joint values `q`, for measuring each shape's clearance apart.
     pub fn probe(&self, q: &[f64], held: Option<(&str, &Isometry3<f64>)>) -> Probe {
-        let poses = self.cell.robot.fk_all(q);
+        let links: Vec<Isometry3<f64>> = self
+            .cell
+            .robot
+            .fk_all(q)
+            .into_iter()
+            .map(|pose| self.cell.robot_base * pose)
+            .collect();
         let tool = self.cell.robot_base * self.cell.robot.fk_tip(q);
         let axes = self
             .cell
@@ -960,22 +979,21 @@ impl Physics {
             .filter_map(|joint| {
                 let i = joint.dof_index?;
                 // The child frame's origin lies on the joint's axis.
-                let origin = (self.cell.robot_base * poses[joint.child])
-                    .translation
-                    .vector;
-                Some((i, joint.kind, origin))
+                Some((i, joint.kind, links[joint.child].translation.vector))
             })
             .collect();
-        let held_body = held.and_then(|(id, _)| self.lumber.get(id));
+        let held_body = held.and_then(|(id, in_tool)| Some((self.lumber.get(id)?, *in_tool)));
         let mut own: Vec<RigidBodyHandle> = self.links.iter().map(|l| l.1).collect();
         own.push(self.tool);
-        own.extend(held_body.map(|b| b.body));
+        own.extend(held_body.map(|(b, _)| b.body));
         Probe {
-            held: held_body.map(|b| b.collider),
-            shapes: self.robot_shapes_at(&poses, &tool, held),
+            links,
+            tool,
             axes,
             dofs: q.len(),
             own,
+            held: held_body.map(|(b, in_tool)| (b.collider, in_tool)),
+            count: self.moving_shapes.len() + usize::from(held_body.is_some()),
             // Riders are measured apart, where they are now: between steps the broad phase
             // holds them where the last step left them.
             riders: self.riding.values().copied().collect(),
@@ -1014,7 +1032,7 @@ impl Physics {
 
     /// The corners of the local bounding box of the probe's shape `i`, in the cell frame.
     fn shape_corners(&self, probe: &Probe, i: usize) -> [Vector3<f64>; 8] {
-        let (c, pose) = &probe.shapes[i];
+        let (c, pose) = &self.probe_shape(probe, i);
         let aabb = self.world.colliders[*c].shape().compute_local_aabb();
         let (lo, hi) = (aabb.mins, aabb.maxs);
         std::array::from_fn(|k| {
@@ -1070,7 +1088,7 @@ impl Physics {
             loose: reach,
             parked: reach,
         };
-        let (c, pose) = probe.shapes[i];
+        let (c, pose) = self.probe_shape(probe, i);
         let collider = &self.world.colliders[c];
         let shape = collider.shape();
         let pose = to_pose(&pose);
@@ -1078,7 +1096,7 @@ impl Physics {
         let filter = QueryFilter::default()
             .groups(collider.collision_groups())
             .predicate(&predicate);
-        let held = probe.held == Some(c);
+        let held = probe.held.is_some_and(|(h, _)| h == c);
         for (h, other) in self.world.intersect_shape(pose * centre, &grown, filter) {
             let loose = other
                 .parent()
@@ -1512,7 +1530,11 @@ mod tests {
         phys.detect();
         let probe = phys.probe(&home, Some(("p", &in_tool)));
         let held = (0..probe.shape_count())
-            .find(|&i| Some(probe.shapes[i].0) == probe.held)
+            .find(|&i| {
+                probe
+                    .held
+                    .is_some_and(|(h, _)| h == phys.probe_shape(&probe, i).0)
+            })
             .expect("the held piece is a shape");
         let watch = Watch::AllBut {
             bodies: ignored,
