@@ -80,9 +80,6 @@ pub struct WallRun<'a> {
     time_limit: f64,
 }
 
-/// Ticks of a straight line per exact IK solution (see `WallRun::run_line`).
-const LINE_IK_TICKS: u64 = 4;
-
 impl<'a> WallRun<'a> {
     pub fn new(
         cell: &'a Cell,
@@ -236,31 +233,15 @@ impl<'a> WallRun<'a> {
         self.q = mv.to.clone();
     }
 
-    /// Follows a straight TCP line; stops (returning the failure) if IK fails on the way. The
-    /// joints are solved exactly every LINE_IK_TICKS ticks and at the end, and interpolated
-    /// in between (over a few millimetres of line the joints' straight line stays within
-    /// micrometres of it).
+    /// Follows a straight TCP line; stops (returning the failure) if IK fails on the way.
     fn run_line(&mut self, mv: &LinearMove, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
-        let mut done = 0;
-        while done < steps {
-            let k = (done + LINE_IK_TICKS).min(steps);
+        for k in 1..=steps {
             let pose = mv.pose_at(k as f64 * self.options.dt);
             let next = solve(&self.cell, &pose, tcp, &self.q)?;
             check_step(&self.cell, &self.q, &next, k as f64 / steps as f64)?;
-            let from = std::mem::take(&mut self.q);
-            for j in done + 1..k {
-                let s = (j - done) as f64 / (k - done) as f64;
-                self.q = from
-                    .iter()
-                    .zip(&next)
-                    .map(|(a, b)| a + (b - a) * s)
-                    .collect();
-                self.tick();
-            }
             self.q = next;
             self.tick();
-            done = k;
         }
         Ok(())
     }
