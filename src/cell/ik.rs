@@ -140,16 +140,7 @@ impl Robot {
         seed: &[f64],
         options: &IkOptions,
     ) -> Result<Vec<Vec<f64>>, IkFailure> {
-        assert_eq!(seed.len(), self.dof(), "seed length");
-        let target = tip_target(pose, tcp)?;
-        match &self.opw {
-            Some(_) => Ok(self
-                .ik_closed_form(&target, seed, options, Variants::All)?
-                .into_iter()
-                .map(|q| q.to_vec())
-                .collect()),
-            None => self.ik_numeric(&target, seed, options),
-        }
+        self.ik_variants(pose, tcp, seed, options, Variants::All)
     }
 
     /// One solution per closed-form branch (of each, the whole-turn copy nearest `seed`),
@@ -162,16 +153,28 @@ impl Robot {
         tcp: &Isometry3<f64>,
         seed: &[f64],
     ) -> Result<Vec<Vec<f64>>, IkFailure> {
-        if self.opw.is_none() {
-            return self.ik(pose, tcp, seed);
-        }
+        self.ik_variants(pose, tcp, seed, &IkOptions::default(), Variants::Nearest)
+    }
+
+    /// `ik_with`, keeping `variants` of the closed form's whole-turn copies.
+    fn ik_variants(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+        seed: &[f64],
+        options: &IkOptions,
+        variants: Variants,
+    ) -> Result<Vec<Vec<f64>>, IkFailure> {
         assert_eq!(seed.len(), self.dof(), "seed length");
         let target = tip_target(pose, tcp)?;
-        Ok(self
-            .ik_closed_form(&target, seed, &IkOptions::default(), Variants::Nearest)?
-            .into_iter()
-            .map(|q| q.to_vec())
-            .collect())
+        match &self.opw {
+            Some(_) => Ok(self
+                .ik_closed_form(&target, seed, options, variants)?
+                .into_iter()
+                .map(|q| q.to_vec())
+                .collect()),
+            None => self.ik_numeric(&target, seed, options),
+        }
     }
 
     /// How far (m) the wrist centre for this TCP pose is inside the arm's reach from the shoulder

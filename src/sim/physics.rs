@@ -194,8 +194,8 @@ pub struct Probe {
     /// Per moving joint: its index in the joint values, kind and a point of its axis.
     axes: Vec<(usize, JointKind, Vector3<f64>)>,
     dofs: usize,
-    /// The robot's bodies and the held piece's, which a clearance leaves out.
-    own: Vec<RigidBodyHandle>,
+    /// The held piece's body: with the robot's own, a clearance leaves it out.
+    held_body: Option<RigidBodyHandle>,
     /// The held piece's collider and its pose in tool0: the last shape.
     held: Option<(ColliderHandle, Isometry3<f64>)>,
     /// How many shapes: the robot's moving colliders, then the held piece.
@@ -207,6 +207,11 @@ impl Probe {
     /// How many shapes it holds.
     pub fn shape_count(&self) -> usize {
         self.count
+    }
+
+    /// The held piece's shape, if a piece is held: the last.
+    pub fn held_shape(&self) -> Option<usize> {
+        self.held.map(|_| self.count - 1)
     }
 }
 
@@ -983,15 +988,12 @@ impl Physics {
             })
             .collect();
         let held_body = held.and_then(|(id, in_tool)| Some((self.lumber.get(id)?, *in_tool)));
-        let mut own: Vec<RigidBodyHandle> = self.links.iter().map(|l| l.1).collect();
-        own.push(self.tool);
-        own.extend(held_body.map(|(b, _)| b.body));
         Probe {
             links,
             tool,
             axes,
             dofs: q.len(),
-            own,
+            held_body: held_body.map(|(b, _)| b.body),
             held: held_body.map(|(b, in_tool)| (b.collider, in_tool)),
             count: self.moving_shapes.len() + usize::from(held_body.is_some()),
             // Riders are measured apart, where they are now: between steps the broad phase
@@ -1076,12 +1078,15 @@ impl Physics {
 
     /// `clearance` of the probe's shape `i` alone.
     pub fn shape_clearance(&self, probe: &Probe, i: usize, reach: f64, watch: Watch) -> Clearance {
-        let (own, riders) = (&probe.own, &probe.riders);
+        let riders = &probe.riders;
+        let own = |b: RigidBodyHandle| {
+            b == self.tool || probe.held_body == Some(b) || self.links.iter().any(|l| l.1 == b)
+        };
         let predicate = |_: ColliderHandle, c: &Collider| {
             !c.is_sensor()
                 && !c
                     .parent()
-                    .is_some_and(|b| own.contains(&b) || riders.iter().any(|r| r.body == b))
+                    .is_some_and(|b| own(b) || riders.iter().any(|r| r.body == b))
         };
         let mut found = Clearance {
             any: reach,
@@ -1096,7 +1101,7 @@ impl Physics {
         let filter = QueryFilter::default()
             .groups(collider.collision_groups())
             .predicate(&predicate);
-        let held = probe.held.is_some_and(|(h, _)| h == c);
+        let held = probe.held_shape() == Some(i);
         for (h, other) in self.world.intersect_shape(pose * centre, &grown, filter) {
             let loose = other
                 .parent()
@@ -1529,13 +1534,7 @@ mod tests {
         phys.place_robot(&home, Some(("p", &in_tool)));
         phys.detect();
         let probe = phys.probe(&home, Some(("p", &in_tool)));
-        let held = (0..probe.shape_count())
-            .find(|&i| {
-                probe
-                    .held
-                    .is_some_and(|(h, _)| h == phys.probe_shape(&probe, i).0)
-            })
-            .expect("the held piece is a shape");
+        let held = probe.held_shape().expect("the held piece is a shape");
         let watch = Watch::AllBut {
             bodies: ignored,
             tolerance: 0.001,
