@@ -107,6 +107,7 @@ fn main() {
             Err(e) => panic!("the built-in rules cannot be compiled to ascent: {e}"),
         }
         table.push(("rules".to_string(), "builtin_rules".to_string()));
+        out.push_str(&placed_slice(&program));
     }
     // Test and benchmark programs: one program per file.
     for dir in ["tests/logic", "benches/logic"] {
@@ -151,4 +152,50 @@ fn main() {
     let dest = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
         .join("logic_compiled.rs");
     std::fs::write(&dest, out).expect("write generated rules");
+}
+
+/// The inputs the placement search (`frame::placement`) fills after a first pass.
+const PLACEMENT_INPUTS: &[&str] = &[
+    "placement_candidate",
+    "placement_reaches",
+    "placement_nail_reaches",
+];
+
+/// The built-in rules that depend on the placement search, as their own ascent program
+/// (`builtin_placed`), and `builtin_placed::finish`, which runs it on a finished first pass
+/// of the whole rule base once the placement inputs are filled in: it borrows the
+/// relations the slice reads but does not derive, gives them back, and replaces every
+/// relation it derives (the first pass derived those without placements).
+fn placed_slice(program: &front::Program) -> String {
+    let derived = program.downstream_of(PLACEMENT_INPUTS);
+    let slice = program.restricted_to(&derived);
+    let heads: std::collections::BTreeSet<&str> =
+        slice.rules.iter().map(|r| r.head.rel.as_str()).collect();
+    let borrowed: Vec<String> = slice
+        .relations_read()
+        .into_iter()
+        .filter(|r| !heads.contains(r.as_str()))
+        .collect();
+    let mut code = front::codegen::generate(&slice, "builtin_placed")
+        .unwrap_or_else(|e| panic!("the placement-dependent rules cannot be compiled: {e}"));
+    let field = |name: &str| format!("r_{}", name.replace('?', "_Q"));
+    code.push_str("impl builtin_placed::Prog {\n");
+    code.push_str("    /// Runs the placement-dependent rules over `base` (see `build.rs`).\n");
+    code.push_str("    pub fn finish(base: &mut builtin_rules::Prog) {\n");
+    code.push_str("        let mut p = Self::default();\n");
+    for r in &borrowed {
+        let f = field(r);
+        let _ = writeln!(code, "        p.{f} = std::mem::take(&mut base.{f});");
+    }
+    code.push_str("        p.run();\n");
+    for r in borrowed
+        .iter()
+        .map(String::as_str)
+        .chain(heads.iter().copied())
+    {
+        let f = field(r);
+        let _ = writeln!(code, "        base.{f} = std::mem::take(&mut p.{f});");
+    }
+    code.push_str("    }\n}\n");
+    code
 }

@@ -1,34 +1,63 @@
-//! `plan` reads only the relations it needs from the compiled rule base, and the placement
-//! search hands the rules only the offsets where a wall's count can rise. Both must leave
-//! the plan as it was: the JSON equals, byte for byte, the one of the full conversion of
-//! every relation with every offset a candidate (the path before), on TM1–TM3 and a
-//! generated multi-storey model with grouped walls, openings and property sets, with both
-//! shipped cells.
+//! `plan` reads only the relations it needs from the compiled rule base, the placement
+//! search hands the rules only the offsets where a wall's count can rise, and with walls
+//! placed by search each part runs the rule base once and then only the rules the search's
+//! facts reach. None of it may change the plan: the JSON equals, byte for byte, the one of
+//! the full conversion of every relation with every offset a candidate and the rule base run
+//! twice (the path before), on TM1–TM3 and a generated multi-storey model with grouped
+//! walls, openings and property sets, with both shipped cells.
 use framewright::cell::Cell;
-use framewright::frame::placement::{SearchOptions, add_placement_facts_with};
+use framewright::frame::placement::{SearchOptions, add_placement_facts_with, reason_placed};
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, cell_facts, model_facts, reason, reason_selected};
+use framewright::frame::{
+    Reasoned, RuleEngine, RuleLimits, cell_facts, model_facts, reason, reason_selected,
+};
 use framewright::ifc::Model;
+use framewright::logic::compiled::builtin;
 use framewright::report::plan::PlanReport;
 use framewright::synth::building::{BlockSpec, blocks};
 use framewright::synth::{Grouping, WriteOptions, models, write_ifc};
 use std::path::{Path, PathBuf};
 
-/// `plan --json` of the model: the earlier path (`before`) or the current one.
-fn plan_json(model: &Model, cell: &Cell, before: bool) -> Vec<u8> {
+/// How the plan is reasoned.
+#[derive(Clone, Copy, Debug)]
+enum Path_ {
+    /// Every relation converted, every offset a candidate, the rule base run twice.
+    Before,
+    /// Only the plan's relations, the rule base run twice.
+    TwoPasses,
+    /// Only the plan's relations, one pass and the placement slice per part.
+    Fused,
+}
+
+/// `plan --json` of the model, reasoned along `path`.
+fn plan_json(model: &Model, cell: &Cell, path: Path_) -> Vec<u8> {
     let mut facts = model_facts(model, &Default::default());
     facts.extend(cell_facts(cell));
-    let options = SearchOptions {
-        every_offset: before,
-        ..SearchOptions::default()
+    let reasoned = match path {
+        Path_::Fused => reason_placed(
+            facts,
+            cell,
+            &RuleEngine::Compiled,
+            Plan::RELATIONS,
+            &RuleLimits::default(),
+        )
+        .expect("reason"),
+        Path_::Before | Path_::TwoPasses => {
+            let before = matches!(path, Path_::Before);
+            let options = SearchOptions {
+                every_offset: before,
+                ..SearchOptions::default()
+            };
+            add_placement_facts_with(&mut facts, cell, &RuleEngine::Compiled, &options)
+                .expect("search");
+            if before {
+                reason(&facts, &RuleEngine::Compiled, false)
+            } else {
+                reason_selected(&facts, &RuleEngine::Compiled, Plan::RELATIONS)
+            }
+            .expect("reason")
+        }
     };
-    add_placement_facts_with(&mut facts, cell, &RuleEngine::Compiled, &options).expect("search");
-    let reasoned = if before {
-        reason(&facts, &RuleEngine::Compiled, false)
-    } else {
-        reason_selected(&facts, &RuleEngine::Compiled, Plan::RELATIONS)
-    }
-    .expect("reason");
     let mut json = Vec::new();
     PlanReport::new(model, &Plan::from_reasoned(model, &reasoned))
         .write_json(&mut json)
@@ -40,16 +69,18 @@ fn assert_same_plan(path: &Path, label: &str) {
     let model = Model::open(path).expect("read");
     for name in ["study-abb", "study-kuka"] {
         let cell = Cell::load(name).expect("cell");
-        let now = plan_json(&model, &cell, false);
-        let before = plan_json(&model, &cell, true);
+        let before = plan_json(&model, &cell, Path_::Before);
         assert!(
-            String::from_utf8_lossy(&now).contains("\"wall_id\""),
+            String::from_utf8_lossy(&before).contains("\"wall_id\""),
             "{label}: the plan has walls"
         );
-        assert!(
-            now == before,
-            "{label}, {name}: the plan differs from the full conversion with every offset"
-        );
+        for path in [Path_::TwoPasses, Path_::Fused] {
+            assert!(
+                plan_json(&model, &cell, path) == before,
+                "{label}, {name}: the plan along {path:?} differs from the full conversion \
+                 with every offset"
+            );
+        }
     }
 }
 
@@ -89,4 +120,62 @@ fn a_generated_block_plans_as_before() {
     let path = dir.path().join("selected.ifc");
     std::fs::write(&path, &written.ifc).expect("write model");
     assert_same_plan(&path, "generated block");
+}
+
+/// Every relation the compiled rule base derives, sorted, reasoned in two passes (the
+/// search's facts added to the model's, the rule base run again) or fused.
+fn every_relation(model: &Model, cell: &Cell, fused: bool) -> Reasoned {
+    let mut facts = model_facts(model, &Default::default());
+    facts.extend(cell_facts(cell));
+    assert!(
+        facts.tuples.keys().all(|k| builtin::INPUTS.contains(k)),
+        "the model's and the cell's facts are all typed inputs, so the fused path applies"
+    );
+    let mut reasoned = if fused {
+        reason_placed(
+            facts,
+            cell,
+            &RuleEngine::Compiled,
+            builtin::OUTPUTS,
+            &RuleLimits::default(),
+        )
+    } else {
+        add_placement_facts_with(
+            &mut facts,
+            cell,
+            &RuleEngine::Compiled,
+            &SearchOptions::default(),
+        )
+        .expect("search");
+        reason_selected(&facts, &RuleEngine::Compiled, builtin::OUTPUTS)
+    }
+    .expect("reason");
+    for tuples in reasoned.relations.values_mut() {
+        tuples.sort();
+    }
+    reasoned
+}
+
+#[test]
+fn the_fused_placement_pass_derives_every_relation_as_two_passes_do() {
+    for tm in ["tm1", "tm3"] {
+        let path =
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("examples/models/{tm}.ifc"));
+        let model = Model::open(&path).expect("read");
+        for name in ["study-kuka", "study-abb-track"] {
+            let cell = Cell::load(name).expect("cell");
+            let two = every_relation(&model, &cell, false);
+            let fused = every_relation(&model, &cell, true);
+            assert!(!two.get("wall_frame").is_empty(), "{tm}: walls placed");
+            assert!(!two.get("nailing_target").is_empty(), "{tm}: nails placed");
+            for relation in builtin::OUTPUTS {
+                assert!(
+                    two.get(relation) == fused.get(relation),
+                    "{tm}, {name}: `{relation}` differs ({} tuples in two passes, {} fused)",
+                    two.get(relation).len(),
+                    fused.get(relation).len()
+                );
+            }
+        }
+    }
 }

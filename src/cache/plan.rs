@@ -12,9 +12,11 @@ use super::value_codec::{Reader, put_relations, put_str, put_tuple, put_u64};
 use super::{Cache, CacheCounts};
 use crate::cell::{Cell, OffsetX};
 use crate::frame::partition::{Part, Partition};
-use crate::frame::placement::{SearchOptions, placement_facts_with};
+use crate::frame::placement::{
+    FIRST_PASS, SearchMemo, SearchOptions, placement_relations, reason_placed,
+};
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, RuleLimits, reason_within};
+use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, RuleLimits};
 use crate::logic::compiled::{Relations, builtin};
 use crate::logic::functors::defs::{box_centre, box_radius, dot};
 use crate::logic::value::{F64, OBox, Value, Vec3};
@@ -22,13 +24,6 @@ use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::Mutex;
 
-/// What the placement search reads of the first pass (as `frame::placement` runs it).
-const FIRST_PASS: &[&str] = &[
-    "piece_size",
-    "wall_of",
-    "placement_target_at_zero",
-    "placement_nail_at_zero",
-];
 /// The relation an entry's context check reads.
 const REACH: &str = "storey_reach";
 /// Start of every entry: the format.
@@ -115,9 +110,10 @@ pub fn reason_plan_cached(
     jobs.sort_by_key(|j| std::cmp::Reverse(j.size(&partition)));
     let total = std::sync::atomic::AtomicU64::new(0);
     let computed: Mutex<Vec<(usize, Relations)>> = Mutex::new(Vec::new());
+    let memo = SearchMemo::default();
     jobs.par_iter()
         .try_for_each(|job| -> Result<(), FrameError> {
-            let (done, tuples) = job.run(&facts, &partition, cell)?;
+            let (done, tuples) = job.run(&facts, &partition, cell, &memo)?;
             let sum = total.fetch_add(tuples, std::sync::atomic::Ordering::Relaxed) + tuples;
             limits.check_tuples(sum)?;
             for (i, relations) in &done {
@@ -163,7 +159,7 @@ fn poisoned() -> FrameError {
 /// A first run (nothing cached): the model reasoned as `plan` does without the cache (one
 /// placement search over every wall, so repeated walls search once), its parts stored.
 fn first_run(
-    mut facts: Facts,
+    facts: Facts,
     cell: &Cell,
     cache: &Cache,
     limits: &RuleLimits,
@@ -176,11 +172,9 @@ fn first_run(
     for part in &mut partition.parts {
         part.relations = Relations::new();
     }
-    crate::frame::placement::add_placement_facts(&mut facts, cell, &RuleEngine::Compiled)?;
     let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
     wanted.push(REACH);
-    let mut reasoned = reason_within(&facts, &RuleEngine::Compiled, false, Some(&wanted), limits)?;
-    drop(facts);
+    let mut reasoned = reason_placed(facts, cell, &RuleEngine::Compiled, &wanted, limits)?;
     let everything: Vec<usize> = (0..partition.parts.len()).collect();
     let shares = shares(partition, &everything, &reasoned.relations);
     let wall_slot = reasoned.relations.keys().position(|n| n == "wall");
@@ -224,6 +218,7 @@ impl Job {
         facts: &Facts,
         partition: &Partition,
         cell: &Cell,
+        memo: &SearchMemo,
     ) -> Result<(Vec<(usize, Relations)>, u64), FrameError> {
         match self {
             Job::Container { parts, .. } => {
@@ -261,7 +256,7 @@ impl Job {
                         .map(|(t, _)| t.clone())
                         .collect(),
                 );
-                let (out, tuples) = reason_part(input, cell)?;
+                let (out, tuples) = reason_part(input, cell, memo)?;
                 let shares = shares(partition, parts, &out);
                 let split = parts
                     .iter()
@@ -285,7 +280,7 @@ impl Job {
                         .or_default()
                         .extend(tuples.iter().cloned());
                 }
-                let (mut out, tuples) = reason_part(input, cell)?;
+                let (mut out, tuples) = reason_part(input, cell, memo)?;
                 // What was derived about the context pieces is theirs, not this part's.
                 for rows in out.values_mut() {
                     rows.retain(|t| {
@@ -301,24 +296,21 @@ impl Job {
 
 /// The placement search (when the cell places walls itself) and the rule base on one
 /// part's or container's facts: `plan`'s relations and the storey's reach rows.
-fn reason_part(mut input: Relations, cell: &Cell) -> Result<(Relations, u64), FrameError> {
-    let mut tuples = 0;
-    if let OffsetX::Auto { min, max } = cell.assembly.offset_x {
-        let first = builtin::run_selected(&input, FIRST_PASS).map_err(FrameError::Compiled)?;
-        tuples += first.tuples;
-        let first = Reasoned {
-            relations: first.relations,
-            engine: None,
-        };
-        let found = placement_facts_with(cell, &first, min, max, &SearchOptions::default());
-        for (name, rows) in found.relations() {
-            input.entry(name).or_default().extend(rows);
-        }
-    }
+fn reason_part(
+    input: Relations,
+    cell: &Cell,
+    memo: &SearchMemo,
+) -> Result<(Relations, u64), FrameError> {
     let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
     wanted.push(REACH);
-    let second = builtin::run_selected(&input, &wanted).map_err(FrameError::Compiled)?;
-    Ok((second.relations, tuples + second.tuples))
+    let run = match cell.assembly.offset_x {
+        OffsetX::Auto { min, max } => builtin::run_placed(&input, FIRST_PASS, &wanted, |first| {
+            placement_relations(cell, first, (min, max), &SearchOptions::default(), memo)
+        }),
+        OffsetX::Fixed { .. } => builtin::run_selected(&input, &wanted),
+    }
+    .map_err(FrameError::Compiled)?;
+    Ok((run.relations, run.tuples))
 }
 
 /// Which tuples of `out` belong to each of `parts`, as (relation slot, tuple index) pairs in

@@ -6,9 +6,9 @@ use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::{ReasoningInputs, load_model_facts, rule_base};
 use super::{CmdResult, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::reason_plan_cached;
-use framewright::frame::placement::add_placement_facts;
+use framewright::frame::RuleLimits;
+use framewright::frame::placement::reason_placed;
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleLimits, reason_selected};
 use framewright::report::plan::PlanReport;
 use std::path::PathBuf;
 
@@ -42,9 +42,11 @@ pub fn run(args: PlanArgs) -> CmdResult {
         }
         None => {
             let engine = rule_base(&inputs.rules_dir);
-            let mut facts = facts;
-            add_placement_facts(&mut facts, &cell, &engine)?;
-            (reason_selected(&facts, &engine, Plan::RELATIONS)?, None)
+            let limits = RuleLimits::from_env()?;
+            (
+                reason_placed(facts, &cell, &engine, Plan::RELATIONS, &limits)?,
+                None,
+            )
         }
     };
     warn_if_unwritable(cache.as_ref());

@@ -174,6 +174,22 @@ fn reason_compiled(
     selected: Option<&[&str]>,
     limits: &RuleLimits,
 ) -> Result<Relations, FrameError> {
+    reason_compiled_placing(facts, selected, limits, None)
+}
+
+/// The placement search for one part: the first pass's relations (`placement::FIRST_PASS`)
+/// in, the part's placement facts out.
+pub(crate) type PlaceFn<'a> = &'a (dyn Fn(&Relations) -> Relations + Sync);
+
+/// `reason_compiled`; with `place` (and `selected`, which the typed runner must handle),
+/// each part's placement facts come from `place` between a first pass and the rules they
+/// reach (`compiled::builtin::run_placed`).
+pub(crate) fn reason_compiled_placing(
+    facts: &Facts,
+    selected: Option<&[&str]>,
+    limits: &RuleLimits,
+    place: Option<PlaceFn>,
+) -> Result<Relations, FrameError> {
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicU64, Ordering};
     let run = compiled::program("rules")
@@ -190,8 +206,19 @@ fn reason_compiled(
     let results: Vec<Relations> = parts
         .into_par_iter()
         .map(|part| -> Result<Relations, FrameError> {
-            let (relations, tuples) = match &wanted {
-                Some(w) if compiled::builtin::handles(&part, w) => {
+            let (relations, tuples) = match (&wanted, place) {
+                (Some(w), Some(place)) if compiled::builtin::handles(&part, w) => {
+                    let r = compiled::builtin::run_placed(&part, placement::FIRST_PASS, w, place)
+                        .map_err(FrameError::Compiled)?;
+                    (r.relations, r.tuples)
+                }
+                (_, Some(_)) => {
+                    return Err(FrameError::Compiled(
+                        "the placement search runs between passes of the typed rule runner only"
+                            .into(),
+                    ));
+                }
+                (Some(w), None) if compiled::builtin::handles(&part, w) => {
                     let r =
                         compiled::builtin::run_selected(&part, w).map_err(FrameError::Compiled)?;
                     (r.relations, r.tuples)

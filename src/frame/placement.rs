@@ -11,12 +11,18 @@
 //! solve, at one of the rolls the executor tries. Every solution counted keeps the arm and
 //! its tool above the floor.
 
-use super::{Facts, FrameError, Reasoned, RuleEngine, reason_selected};
+use super::{
+    Facts, FrameError, Reasoned, RuleEngine, RuleLimits, reason_compiled_placing, reason_selected,
+    reason_within,
+};
 use crate::cell::tcp_poses::{centre_grip, lowest_point, nail_pose, nail_rolls, retreat};
 use crate::cell::{Cell, OffsetX};
+use crate::logic::compiled::{Relations, builtin};
 use crate::logic::{Origin, Value};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Spacing of the offsets tried (m).
 pub const OFFSET_STEP: f64 = 0.01;
@@ -83,8 +89,42 @@ pub fn add_placement_facts_with(
     Ok(())
 }
 
+/// The rule base's `selected` relations with the walls placed as the cell says: what
+/// `add_placement_facts` and then `reason_within` give. With the compiled rules and a cell
+/// that places walls by search, each part of the model runs the rule base once, the search,
+/// and then only the rules the search's facts reach (the first pass's other relations stand).
+pub fn reason_placed(
+    mut facts: Facts,
+    cell: &Cell,
+    engine: &RuleEngine,
+    selected: &[&str],
+    limits: &RuleLimits,
+) -> Result<Reasoned, FrameError> {
+    let typed = matches!(engine, RuleEngine::Compiled)
+        && facts.tuples.keys().all(|k| builtin::INPUTS.contains(k))
+        && selected.iter().all(|w| builtin::OUTPUTS.contains(w));
+    let OffsetX::Auto { min, max } = cell.assembly.offset_x else {
+        return reason_within(&facts, engine, false, Some(selected), limits);
+    };
+    if !typed {
+        add_placement_facts(&mut facts, cell, engine)?;
+        return reason_within(&facts, engine, false, Some(selected), limits);
+    }
+    let memo = SearchMemo::default();
+    let options = SearchOptions::default();
+    let place = |first: &Relations| placement_relations(cell, first, (min, max), &options, &memo);
+    let relations = reason_compiled_placing(&facts, Some(selected), limits, Some(&place))?;
+    drop(facts);
+    let reasoned = Reasoned {
+        relations,
+        engine: None,
+    };
+    limits.check_walls(reasoned.get("wall").len() as u64)?;
+    Ok(reasoned)
+}
+
 /// What the search reads of the first pass.
-const FIRST_PASS: &[&str] = &[
+pub(crate) const FIRST_PASS: &[&str] = &[
     "piece_size",
     "wall_of",
     "placement_target_at_zero",
@@ -115,9 +155,77 @@ pub fn placement_facts_with(
     max: f64,
     options: &SearchOptions,
 ) -> Facts {
+    let mut facts = Facts::default();
+    search(
+        cell,
+        &first.relations,
+        (min, max),
+        options,
+        &SearchMemo::default(),
+        &mut |relation, tuple, origin| facts.add(relation, tuple, Origin::Event(origin())),
+    );
+    facts
+}
+
+/// Search results shared by every part of a model reasoned part by part, so repeated
+/// walls in different storeys search once.
+#[derive(Default)]
+pub(crate) struct SearchMemo {
+    pieces: Memo,
+    nails: Memo,
+}
+
+type Memo = Mutex<FxHashMap<[i64; 10], Shared>>;
+
+/// Reach runs of one search key, filled by whichever part searches the key first.
+type Shared = Arc<OnceLock<Vec<(f64, f64)>>>;
+
+/// Takes one placement fact: relation, tuple, and how to say where it came from.
+type AddFact<'a> = dyn FnMut(&'static str, Vec<Value>, &dyn Fn() -> String) + 'a;
+
+/// The placement facts of one part for the typed runner (`compiled::builtin::run_placed`):
+/// what `placement_facts_with` gives, without origins, each relation sorted.
+pub(crate) fn placement_relations(
+    cell: &Cell,
+    first: &Relations,
+    range: (f64, f64),
+    options: &SearchOptions,
+    memo: &SearchMemo,
+) -> Relations {
+    let mut relations = Relations::new();
+    search(
+        cell,
+        first,
+        range,
+        options,
+        memo,
+        &mut |relation, tuple, _| {
+            relations
+                .entry(relation.to_string())
+                .or_default()
+                .push(tuple)
+        },
+    );
+    for tuples in relations.values_mut() {
+        tuples.sort();
+        tuples.dedup();
+    }
+    relations
+}
+
+/// Runs the search and hands each fact to `add` (relation, tuple, and how to say where it
+/// came from).
+fn search(
+    cell: &Cell,
+    first: &Relations,
+    (min, max): (f64, f64),
+    options: &SearchOptions,
+    memo: &SearchMemo,
+    add: &mut AddFact,
+) {
+    let get = |relation: &str| first.get(relation).map_or(&[][..], Vec::as_slice);
     let offsets = candidate_offsets(min, max);
-    let sizes: BTreeMap<&str, [f64; 3]> = first
-        .get("piece_size")
+    let sizes: BTreeMap<&str, [f64; 3]> = get("piece_size")
         .iter()
         .filter_map(|t| {
             let p = t.first()?.as_symbol()?;
@@ -125,13 +233,11 @@ pub fn placement_facts_with(
             Some((p, [f(1)?, f(2)?, f(3)?]))
         })
         .collect();
-    let walls: BTreeMap<&str, &str> = first
-        .get("wall_of")
+    let walls: BTreeMap<&str, &str> = get("wall_of")
         .iter()
         .filter_map(|t| Some((t.first()?.as_symbol()?, t.get(1)?.as_symbol()?)))
         .collect();
-    let pieces: Vec<(&str, Isometry3<f64>, [f64; 3])> = first
-        .get("placement_target_at_zero")
+    let pieces: Vec<(&str, Isometry3<f64>, [f64; 3])> = get("placement_target_at_zero")
         .iter()
         .filter_map(|t| {
             let p = t.first()?.as_symbol()?;
@@ -145,7 +251,7 @@ pub fn placement_facts_with(
     let reached = search_each(
         &pieces,
         |(_, pose, size)| pose_key(pose, size),
-        share,
+        share.then_some(&memo.pieces),
         |(_, at_zero, size)| {
             let ok: Vec<bool> = offsets
                 .iter()
@@ -154,8 +260,7 @@ pub fn placement_facts_with(
             robustly(&offsets, &ok)
         },
     );
-    let nails: Vec<(Vec<Value>, Point3<f64>, Vector3<f64>)> = first
-        .get("placement_nail_at_zero")
+    let nails: Vec<(Vec<Value>, Point3<f64>, Vector3<f64>)> = get("placement_nail_at_zero")
         .iter()
         .filter_map(|t| {
             let (Some(Value::Vec3(point)), Some(Value::Vec3(direction))) = (t.get(5), t.get(6))
@@ -173,7 +278,7 @@ pub fn placement_facts_with(
             key[3..6].copy_from_slice(&grid(direction));
             key
         },
-        share,
+        share.then_some(&memo.nails),
         |(_, point, direction)| {
             let ok: Vec<bool> = offsets
                 .iter()
@@ -183,7 +288,6 @@ pub fn placement_facts_with(
         },
     );
 
-    let mut facts = Facts::default();
     let candidates = wall_candidates(
         &offsets,
         &walls,
@@ -196,21 +300,23 @@ pub fn placement_facts_with(
     );
     for (w, xs) in candidates {
         for x in xs {
-            facts.add(
+            add(
                 "placement_candidate",
                 vec![Value::sym(w), Value::float(x)],
-                Origin::Event(format!("placement search: wall {w} tried at x = {x:.3} m")),
+                &|| format!("placement search: wall {w} tried at x = {x:.3} m"),
             );
         }
     }
     for ((p, _, _), runs) in pieces.iter().zip(&reached) {
         for &(from, to) in runs {
-            facts.add(
+            add(
                 "placement_reaches",
                 vec![Value::sym(p), Value::float(from), Value::float(to)],
-                Origin::Event(format!(
-                    "placement search: IK solves the place pose of {p} and the pose above it with its wall at every x from {from:.3} to {to:.3} m"
-                )),
+                &|| {
+                    format!(
+                        "placement search: IK solves the place pose of {p} and the pose above it with its wall at every x from {from:.3} to {to:.3} m"
+                    )
+                },
             );
         }
     }
@@ -218,17 +324,14 @@ pub fn placement_facts_with(
         for &(from, to) in runs {
             let mut tuple = key.clone();
             tuple.extend([Value::float(from), Value::float(to)]);
-            facts.add(
-                "placement_nail_reaches",
-                tuple,
-                Origin::Event(format!(
+            add("placement_nail_reaches", tuple, &|| {
+                format!(
                     "placement search: IK solves the nailer's pose and its approach for a nail of {} into {} with the wall at every x from {from:.3} to {to:.3} m",
                     key[0], key[1]
-                )),
-            );
+                )
+            });
         }
     }
-    facts
 }
 
 /// The offsets tried for each wall (walls sorted by name, offsets ascending). The count of
@@ -260,19 +363,20 @@ fn wall_candidates<'a>(
     starts
 }
 
-/// `search` for every item, in parallel; with `share`, items of one key run it once (the
-/// first of them in order stands for the rest, so the result is deterministic).
+/// `search` for every item, in parallel; with a memo, items of one key run it once (in this
+/// call or an earlier one with the same memo; equal keys give equal results, so the result
+/// is deterministic).
 fn search_each<T: Sync>(
     items: &[T],
-    key: impl Fn(&T) -> [i64; 10],
-    share: bool,
+    key: impl Fn(&T) -> [i64; 10] + Sync,
+    memo: Option<&Memo>,
     search: impl Fn(&T) -> Vec<(f64, f64)> + Sync,
 ) -> Vec<Vec<(f64, f64)>> {
     use rayon::prelude::*;
-    if !share {
+    let Some(memo) = memo else {
         return items.par_iter().map(&search).collect();
-    }
-    let mut first_of: rustc_hash::FxHashMap<[i64; 10], usize> = Default::default();
+    };
+    let mut first_of: FxHashMap<[i64; 10], usize> = FxHashMap::default();
     let mut unique: Vec<&T> = Vec::new();
     let slot: Vec<usize> = items
         .iter()
@@ -283,7 +387,20 @@ fn search_each<T: Sync>(
             })
         })
         .collect();
-    let found: Vec<Vec<(f64, f64)>> = unique.par_iter().map(|item| search(item)).collect();
+    let cells: Vec<Shared> = {
+        let mut memo = memo.lock().unwrap_or_else(|e| e.into_inner());
+        unique
+            .iter()
+            .map(|item| memo.entry(key(item)).or_default().clone())
+            .collect()
+    };
+    // A key another thread is searching waits for its result (the search runs no parallel
+    // work of its own, so waiting cannot deadlock).
+    let found: Vec<&Vec<(f64, f64)>> = unique
+        .par_iter()
+        .zip(&cells)
+        .map(|(item, cell)| cell.get_or_init(|| search(item)))
+        .collect();
     slot.into_iter().map(|k| found[k].clone()).collect()
 }
 

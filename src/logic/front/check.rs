@@ -51,6 +51,66 @@ impl Program {
             .map_or("<unknown>", |s| s.name.as_str());
         format!("{file}:{}", span.line)
     }
+    /// The relations whose tuples can change with any of `sources`: the sources and every
+    /// relation a rule derives from one of them (through atoms, negations or aggregates),
+    /// transitively.
+    pub fn downstream_of(&self, sources: &[&str]) -> BTreeSet<String> {
+        let mut reached: BTreeSet<String> = sources.iter().map(|s| s.to_string()).collect();
+        loop {
+            let before = reached.len();
+            for rule in &self.rules {
+                if reached.contains(&rule.head.rel) {
+                    continue;
+                }
+                let mut deps = Vec::new();
+                collect_deps(&rule.body, false, &self.rel_index, &mut deps);
+                if deps
+                    .iter()
+                    .any(|(b, _, _)| reached.contains(&self.relations[*b].name))
+                {
+                    reached.insert(rule.head.rel.clone());
+                }
+            }
+            if reached.len() == before {
+                return reached;
+            }
+        }
+    }
+
+    /// The program with only the rules (and facts) whose head is one of `heads`; every
+    /// relation stays declared, so the others can be filled as inputs. When `heads` is closed
+    /// under `downstream_of`, running this over the other relations' complete tuples gives
+    /// `heads` the tuples the whole program gives them (strata below stay as they were).
+    pub fn restricted_to(&self, heads: &BTreeSet<String>) -> Program {
+        let mut slice = self.clone();
+        slice.rules.retain(|r| heads.contains(&r.head.rel));
+        for stratum in &mut slice.strata {
+            stratum.rules.clear();
+        }
+        for (i, rule) in slice.rules.iter().enumerate() {
+            let head = self.rel_index[&rule.head.rel];
+            if let Some(s) = slice
+                .strata
+                .iter_mut()
+                .find(|s| s.relations.contains(&head))
+            {
+                s.rules.push(i);
+            }
+        }
+        slice
+    }
+
+    /// The relations the rules read (in atoms, negations and aggregates).
+    pub fn relations_read(&self) -> BTreeSet<String> {
+        let mut deps = Vec::new();
+        for rule in &self.rules {
+            collect_deps(&rule.body, false, &self.rel_index, &mut deps);
+        }
+        deps.iter()
+            .map(|(b, _, _)| self.relations[*b].name.clone())
+            .collect()
+    }
+
     /// How explanations cite a rule: `label (file:line)` or `rule (file:line)`.
     pub fn rule_name(&self, rule: usize) -> String {
         let r = &self.rules[rule];
@@ -1742,5 +1802,51 @@ fn is_int_const(e: &Expr) -> bool {
         ExprKind::Neg(x) => is_int_const(x),
         ExprKind::Bin(_, a, b) => is_int_const(a) && is_int_const(b),
         _ => false,
+    }
+}
+
+#[cfg(test)]
+mod slice_tests {
+    use super::super::load_str;
+    use std::collections::BTreeSet;
+
+    const TEXT: &str = r#"
+.decl seed(x: symbol)
+.input seed
+.decl other(x: symbol)
+.input other
+.decl a(x: symbol)
+.decl b(x: symbol)
+.decl c(x: symbol)
+.decl d(x: symbol)
+.output d
+a(x) :- seed(x).
+b(x) :- a(x).
+c(x) :- other(x).
+b(x) :- c(x).
+d(x) :- c(x), !b(x).
+"#;
+
+    #[test]
+    fn downstream_follows_atoms_and_negations_transitively() {
+        let program = load_str("slice.dl", TEXT, &[]).expect("program");
+        let reached = program.downstream_of(&["seed"]);
+        let names: BTreeSet<&str> = reached.iter().map(String::as_str).collect();
+        // c reads only `other`; d reads b through a negation.
+        assert_eq!(names, BTreeSet::from(["seed", "a", "b", "d"]));
+    }
+
+    #[test]
+    fn a_slice_keeps_every_rule_of_its_heads_and_reads_the_rest() {
+        let program = load_str("slice.dl", TEXT, &[]).expect("program");
+        let slice = program.restricted_to(&program.downstream_of(&["seed"]));
+        let heads: Vec<&str> = slice.rules.iter().map(|r| r.head.rel.as_str()).collect();
+        // Both rules for b stay, the one from c included; c's own rule goes.
+        assert_eq!(heads, ["a", "b", "b", "d"]);
+        let in_strata: usize = slice.strata.iter().map(|s| s.rules.len()).sum();
+        assert_eq!(in_strata, 4, "every kept rule sits in its stratum");
+        let read: BTreeSet<String> = slice.relations_read();
+        let read: BTreeSet<&str> = read.iter().map(String::as_str).collect();
+        assert_eq!(read, BTreeSet::from(["seed", "a", "b", "c"]));
     }
 }
