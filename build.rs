@@ -12,6 +12,10 @@ mod front;
 
 use front::ast::BaseTy;
 
+#[allow(dead_code)]
+#[path = "src/frame/rule_reads.rs"]
+mod rule_reads;
+
 /// The functor signatures, read from the same table the crate uses.
 trait Ty {
     const TY: BaseTy;
@@ -74,6 +78,7 @@ fn main() {
         PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     println!("cargo:rerun-if-changed=src/logic/front");
     println!("cargo:rerun-if-changed=src/logic/functor_defs.rs");
+    println!("cargo:rerun-if-changed=src/frame/rule_reads.rs");
     let mut out = String::new();
     let mut table = Vec::new();
     for dir in ["rules", "tests/logic", "benches/logic", SOUFFLE_CORPUS] {
@@ -107,7 +112,8 @@ fn main() {
             Err(e) => panic!("the built-in rules cannot be compiled to ascent: {e}"),
         }
         table.push(("rules".to_string(), "builtin_rules".to_string()));
-        out.push_str(&placed_slice(&program));
+        out.push_str(&placed_slice(&program, "builtin_rules", "builtin_placed"));
+        out.push_str(&plan_scope(&program));
     }
     // Test and benchmark programs: one program per file.
     for dir in ["tests/logic", "benches/logic"] {
@@ -154,20 +160,44 @@ fn main() {
     std::fs::write(&dest, out).expect("write generated rules");
 }
 
-/// The inputs the placement search (`frame::placement`) fills after a first pass.
-const PLACEMENT_INPUTS: &[&str] = &[
-    "placement_candidate",
-    "placement_reaches",
-    "placement_nail_reaches",
-];
+/// The rule base cut down to what `plan` asks of it (`rule_reads`): every rule of a relation
+/// those depend on, as its own ascent program (`builtin_plan`, with its placement slice
+/// `builtin_plan_placed`), and `BUILTIN_PLAN_RELATIONS`, the relations it derives exactly
+/// as the whole rule base does (a caller wanting any other must run the whole).
+fn plan_scope(program: &front::Program) -> String {
+    let mut targets: Vec<&str> = rule_reads::PLAN.to_vec();
+    targets.extend(rule_reads::PLACEMENT_FIRST_PASS);
+    targets.push(rule_reads::STOREY_REACH);
+    let scope = program.upstream_of(&targets);
+    let cut = program.restricted_to(&scope);
+    let mut code = front::codegen::generate(&cut, "builtin_plan")
+        .unwrap_or_else(|e| panic!("the rules `plan` reads cannot be compiled: {e}"));
+    code.push_str(&placed_slice(&cut, "builtin_plan", "builtin_plan_placed"));
+    code.push_str(
+        "/// The relations `builtin_plan` derives as the whole rule base does.
+",
+    );
+    code.push_str(
+        "pub const BUILTIN_PLAN_RELATIONS: &[&str] = &[
+",
+    );
+    for r in &scope {
+        let _ = writeln!(code, "    {r:?},");
+    }
+    code.push_str(
+        "];
+",
+    );
+    code
+}
 
-/// The built-in rules that depend on the placement search, as their own ascent program
-/// (`builtin_placed`), and `builtin_placed::finish`, which runs it on a finished first pass
-/// of the whole rule base once the placement inputs are filled in: it borrows the
+/// The rules of `program` (compiled as module `base`) that depend on the placement search,
+/// as their own ascent program (module `name`), and its `finish`, which runs it on a
+/// finished first pass of `base` once the placement inputs are filled in: it borrows the
 /// relations the slice reads but does not derive, gives them back, and replaces every
 /// relation it derives (the first pass derived those without placements).
-fn placed_slice(program: &front::Program) -> String {
-    let derived = program.downstream_of(PLACEMENT_INPUTS);
+fn placed_slice(program: &front::Program, base: &str, name: &str) -> String {
+    let derived = program.downstream_of(rule_reads::PLACEMENT_INPUTS);
     let slice = program.restricted_to(&derived);
     let heads: std::collections::BTreeSet<&str> =
         slice.rules.iter().map(|r| r.head.rel.as_str()).collect();
@@ -176,12 +206,12 @@ fn placed_slice(program: &front::Program) -> String {
         .into_iter()
         .filter(|r| !heads.contains(r.as_str()))
         .collect();
-    let mut code = front::codegen::generate(&slice, "builtin_placed")
+    let mut code = front::codegen::generate(&slice, name)
         .unwrap_or_else(|e| panic!("the placement-dependent rules cannot be compiled: {e}"));
     let field = |name: &str| format!("r_{}", name.replace('?', "_Q"));
-    code.push_str("impl builtin_placed::Prog {\n");
+    let _ = writeln!(code, "impl {name}::Prog {{");
     code.push_str("    /// Runs the placement-dependent rules over `base` (see `build.rs`).\n");
-    code.push_str("    pub fn finish(base: &mut builtin_rules::Prog) {\n");
+    let _ = writeln!(code, "    pub fn finish(base: &mut {base}::Prog) {{");
     code.push_str("        let mut p = Self::default();\n");
     for r in &borrowed {
         let f = field(r);

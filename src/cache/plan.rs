@@ -25,7 +25,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::Mutex;
 
 /// The relation an entry's context check reads.
-const REACH: &str = "storey_reach";
+const REACH: &str = crate::frame::rule_reads::STOREY_REACH;
 /// Start of every entry: the format.
 const MAGIC: &[u8] = b"framewright plan part 1\n";
 /// Above this share of missed parts a container is reasoned whole (one run, split into

@@ -9,6 +9,7 @@ pub mod limits;
 pub mod partition;
 pub mod placement;
 pub mod plan;
+pub mod rule_reads;
 
 use crate::logic::compiled::{self, Relations};
 use crate::logic::{Diagnostics, Engine, LogicError, Options, Program, Value};

@@ -124,12 +124,7 @@ pub fn reason_placed(
 }
 
 /// What the search reads of the first pass.
-pub(crate) const FIRST_PASS: &[&str] = &[
-    "piece_size",
-    "wall_of",
-    "placement_target_at_zero",
-    "placement_nail_at_zero",
-];
+pub(crate) const FIRST_PASS: &[&str] = super::rule_reads::PLACEMENT_FIRST_PASS;
 
 /// The offsets tried: `min` to `max` every OFFSET_STEP, in whole millimetres.
 pub fn candidate_offsets(min: f64, max: f64) -> Vec<f64> {

@@ -81,23 +81,7 @@ fn iso(v: &Value) -> Isometry3<f64> {
 
 impl Plan {
     /// The relations `from_reasoned` reads (`frame::reason_selected` returns only these).
-    pub const RELATIONS: &'static [&'static str] = &[
-        "wall",
-        "wall_of",
-        "role",
-        "piece_material",
-        "wall_group",
-        "wall_frame",
-        "wall_size",
-        "assembly_rank",
-        "precedence",
-        "nailing_target",
-        "framing_target",
-        "frame_warning",
-        "lumber",
-        "across",
-        "coplanar",
-    ];
+    pub const RELATIONS: &'static [&'static str] = super::rule_reads::PLAN;
 
     /// Collects the plan from the rule base's relations (missing relations give empty parts).
     pub fn from_reasoned(model: &Model, r: &Reasoned) -> Plan {

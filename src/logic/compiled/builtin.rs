@@ -1,10 +1,11 @@
 //! The compiled built-in rule base with typed access: its inputs are filled from `Value`
 //! tuples as the generated wrapper does, but only the relations a caller names are turned
 //! back into `Value` tuples (the wrapper converts and sorts all of them, most of which
-//! `plan` never reads), and the program's own tables are dropped right after.
+//! `plan` never reads), and the program's own tables are dropped right after. A caller that
+//! wants only relations `plan` reads gets them from `builtin_plan`, the rule base cut down to
+//! the rules those depend on (`build.rs`, `frame::rule_reads`).
 
-use super::builtin_rules::Prog;
-use super::{Relations, rt};
+use super::{BUILTIN_PLAN_RELATIONS, Relations, builtin_plan, builtin_rules, rt};
 use crate::logic::value::{Column, F64, OBox, Sym, Value, Vec3};
 
 /// What one run gives: the named relations (each sorted, no duplicates) and how many tuples
@@ -15,10 +16,8 @@ pub struct SelectedRun {
 }
 
 macro_rules! inputs {
-    ($($name:literal => $field:ident ($($i:tt : $t:ty),*);)*) => {
-        /// Every input relation this runner fills.
-        pub const INPUTS: &[&str] = &[$($name),*];
-        fn fill_inputs(p: &mut Prog, edb: &Relations) {
+    (@fill $prog:path, $f:ident; $($name:literal => $field:ident ($($i:tt : $t:ty),*);)*) => {
+        fn $f(p: &mut $prog, edb: &Relations) {
             $(
                 if let Some(ts) = edb.get($name) {
                     p.$field = ts
@@ -29,13 +28,21 @@ macro_rules! inputs {
             )*
         }
     };
+    (@names $($name:literal => $field:ident ($($i:tt : $t:ty),*);)*) => {
+        /// Every input relation this runner fills.
+        pub const INPUTS: &[&str] = &[$($name),*];
+    };
+    // Both compiled copies declare every relation, so one list serves both.
+    ($($list:tt)*) => {
+        inputs!(@names $($list)*);
+        inputs!(@fill builtin_rules::Prog, fill_whole; $($list)*);
+        inputs!(@fill builtin_plan::Prog, fill_plan; $($list)*);
+    };
 }
 
 macro_rules! outputs {
-    ($($name:literal => $field:ident ($($i:tt),*);)*) => {
-        /// Every relation this runner can read back.
-        pub const OUTPUTS: &[&str] = &[$($name),*];
-        fn read_outputs(p: &Prog, wanted: &[&str], out: &mut Relations) {
+    (@read $prog:path, $f:ident; $($name:literal => $field:ident ($($i:tt),*);)*) => {
+        fn $f(p: &$prog, wanted: &[&str], out: &mut Relations) {
             $(
                 if wanted.contains(&$name) {
                     let mut v: Vec<Vec<Value>> = p
@@ -50,6 +57,65 @@ macro_rules! outputs {
             )*
         }
     };
+    (@names $($name:literal => $field:ident ($($i:tt),*);)*) => {
+        /// Every relation this runner can read back.
+        pub const OUTPUTS: &[&str] = &[$($name),*];
+    };
+    ($($list:tt)*) => {
+        outputs!(@names $($list)*);
+        outputs!(@read builtin_rules::Prog, read_whole; $($list)*);
+        outputs!(@read builtin_plan::Prog, read_plan; $($list)*);
+    };
+}
+
+/// The typed tables of one compiled copy of the rule base.
+trait Tables: Default {
+    fn fill_inputs(&mut self, edb: &Relations);
+    fn read_outputs(&self, wanted: &[&str], out: &mut Relations);
+    fn run_rules(&mut self);
+    fn sizes_summary(&self) -> String;
+    /// Runs the rules the placement facts reach (the copy's placement slice).
+    fn finish_placed(&mut self);
+}
+
+macro_rules! tables {
+    ($prog:path, $fill:ident, $read:ident, $placed:path) => {
+        impl Tables for $prog {
+            fn fill_inputs(&mut self, edb: &Relations) {
+                $fill(self, edb)
+            }
+            fn read_outputs(&self, wanted: &[&str], out: &mut Relations) {
+                $read(self, wanted, out)
+            }
+            fn run_rules(&mut self) {
+                self.run()
+            }
+            fn sizes_summary(&self) -> String {
+                self.relation_sizes_summary()
+            }
+            fn finish_placed(&mut self) {
+                <$placed>::finish(self)
+            }
+        }
+    };
+}
+
+tables!(
+    builtin_rules::Prog,
+    fill_whole,
+    read_whole,
+    super::builtin_placed::Prog
+);
+tables!(
+    builtin_plan::Prog,
+    fill_plan,
+    read_plan,
+    super::builtin_plan_placed::Prog
+);
+
+/// Whether `builtin_plan` derives every one of `names` as the whole rule base does.
+fn in_plan_scope(names: &[&str]) -> bool {
+    names.iter().all(|n| BUILTIN_PLAN_RELATIONS.contains(n))
 }
 
 inputs! {
@@ -99,18 +165,27 @@ pub fn handles(edb: &Relations, wanted: &[&str]) -> bool {
 }
 
 /// Runs the built-in rule base on `edb` and returns the relations named in `wanted` (callers
-/// check `handles` first; others are left out).
+/// check `handles` first; others are left out). `tuples` counts what the copy that ran
+/// derived (the cut copy derives less).
 pub fn run_selected(edb: &Relations, wanted: &[&str]) -> Result<SelectedRun, String> {
+    if in_plan_scope(wanted) {
+        selected::<builtin_plan::Prog>(edb, wanted)
+    } else {
+        selected::<builtin_rules::Prog>(edb, wanted)
+    }
+}
+
+fn selected<P: Tables>(edb: &Relations, wanted: &[&str]) -> Result<SelectedRun, String> {
     rt::reset_error();
-    let mut p = Prog::default();
-    fill_inputs(&mut p, edb);
-    p.run();
+    let mut p = P::default();
+    p.fill_inputs(edb);
+    p.run_rules();
     if let Some(e) = rt::take_error() {
         return Err(e);
     }
-    let tuples = declared_tuples(&p.relation_sizes_summary());
+    let tuples = declared_tuples(&p.sizes_summary());
     let mut relations = Relations::new();
-    read_outputs(&p, wanted, &mut relations);
+    p.read_outputs(wanted, &mut relations);
     Ok(SelectedRun { relations, tuples })
 }
 
@@ -125,24 +200,37 @@ pub fn run_placed(
     wanted: &[&str],
     place: impl FnOnce(&Relations) -> Relations,
 ) -> Result<SelectedRun, String> {
+    if in_plan_scope(first) && in_plan_scope(wanted) {
+        placed::<builtin_plan::Prog>(edb, first, wanted, place)
+    } else {
+        placed::<builtin_rules::Prog>(edb, first, wanted, place)
+    }
+}
+
+fn placed<P: Tables>(
+    edb: &Relations,
+    first: &[&str],
+    wanted: &[&str],
+    place: impl FnOnce(&Relations) -> Relations,
+) -> Result<SelectedRun, String> {
     rt::reset_error();
-    let mut p = Prog::default();
-    fill_inputs(&mut p, edb);
-    p.run();
+    let mut p = P::default();
+    p.fill_inputs(edb);
+    p.run_rules();
     if let Some(e) = rt::take_error() {
         return Err(e);
     }
     let mut first_pass = Relations::new();
-    read_outputs(&p, first, &mut first_pass);
-    fill_inputs(&mut p, &place(&first_pass));
+    p.read_outputs(first, &mut first_pass);
+    p.fill_inputs(&place(&first_pass));
     drop(first_pass);
-    super::builtin_placed::Prog::finish(&mut p);
+    p.finish_placed();
     if let Some(e) = rt::take_error() {
         return Err(e);
     }
-    let tuples = declared_tuples(&p.relation_sizes_summary());
+    let tuples = declared_tuples(&p.sizes_summary());
     let mut relations = Relations::new();
-    read_outputs(&p, wanted, &mut relations);
+    p.read_outputs(wanted, &mut relations);
     Ok(SelectedRun { relations, tuples })
 }
 
@@ -165,5 +253,38 @@ mod tests {
     fn counts_declared_relations_only() {
         let summary = "r_wall size: 3\nr_wall_of size: 40\n__agg2 size: 1000\n";
         assert_eq!(declared_tuples(summary), 43);
+    }
+
+    #[test]
+    fn plan_runs_on_the_cut_copy_and_the_simulation_on_the_whole() {
+        use crate::frame::rule_reads::{PLACEMENT_FIRST_PASS, PLAN, STOREY_REACH};
+        assert!(in_plan_scope(PLAN) && in_plan_scope(PLACEMENT_FIRST_PASS));
+        assert!(in_plan_scope(&[STOREY_REACH]));
+        // What only the simulation reads is left out of the cut copy (so `plan` never pays
+        // for the conveyor queue's pairs of pieces).
+        for relation in ["spawn_queue", "spawn"] {
+            assert!(
+                !in_plan_scope(&[relation]),
+                "{relation} is outside the cut copy"
+            );
+        }
+    }
+
+    #[test]
+    fn both_copies_give_the_plan_relations_alike() {
+        use crate::frame::rule_reads::PLAN;
+        // TM1 at the study's placement (bottom plate's outer face 0.881 m from the base).
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/models/tm1.ifc");
+        let model = crate::ifc::Model::open(std::path::Path::new(path)).expect("model");
+        let mut facts = crate::frame::model_facts(&model, &Default::default());
+        let mut cell = crate::cell::Cell::load("study-abb").expect("cell");
+        cell.assembly.offset_x = crate::cell::OffsetX::Fixed { x: 0.881 };
+        facts.extend(crate::frame::cell_facts(&cell));
+        let edb = facts.by_container().into_iter().next().expect("one storey");
+        let cut = selected::<builtin_plan::Prog>(&edb, PLAN).expect("cut copy");
+        let whole = selected::<builtin_rules::Prog>(&edb, PLAN).expect("whole");
+        assert!(!cut.relations["framing_target"].is_empty());
+        assert_eq!(cut.relations, whole.relations);
+        assert!(cut.tuples < whole.tuples, "the cut copy derives less");
     }
 }

@@ -77,6 +77,26 @@ impl Program {
         }
     }
 
+    /// The relations `targets` can depend on: the targets and every relation a rule for one
+    /// of them reads (through atoms, negations or aggregates), transitively.
+    pub fn upstream_of(&self, targets: &[&str]) -> BTreeSet<String> {
+        let mut reached: BTreeSet<String> = targets.iter().map(|s| s.to_string()).collect();
+        let mut todo: Vec<String> = reached.iter().cloned().collect();
+        while let Some(relation) = todo.pop() {
+            for rule in self.rules.iter().filter(|r| r.head.rel == relation) {
+                let mut deps = Vec::new();
+                collect_deps(&rule.body, false, &self.rel_index, &mut deps);
+                for (b, _, _) in deps {
+                    let name = &self.relations[b].name;
+                    if reached.insert(name.clone()) {
+                        todo.push(name.clone());
+                    }
+                }
+            }
+        }
+        reached
+    }
+
     /// The program with only the rules (and facts) whose head is one of `heads`; every
     /// relation stays declared, so the others can be filled as inputs. When `heads` is closed
     /// under `downstream_of`, running this over the other relations' complete tuples gives
