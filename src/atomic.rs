@@ -17,6 +17,25 @@ pub fn write_atomically_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    write_via_temp(path, fill, true)
+}
+
+/// `write_atomically_with` without flushing to disk: a run that stops half-way still leaves
+/// the previous file or none, but a power loss may leave a torn file under the final name.
+/// For cache entries only, which are checked (key and digest) whenever they are read and
+/// recomputed when they fail; the two flushes per file cost more than the entry's work.
+pub fn write_entry_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    write_via_temp(path, fill, false)
+}
+
+fn write_via_temp(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    durable: bool,
+) -> std::io::Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -34,11 +53,13 @@ pub fn write_atomically_with(
         fill(&mut w)?;
         w.flush()?;
     }
-    tmp.as_file().sync_all()?;
+    if durable {
+        tmp.as_file().sync_all()?;
+    }
     // Dropping `tmp` on any error above removes the temporary file.
     tmp.persist(path).map_err(|e| e.error)?;
     // Make the rename itself durable; not every platform can open a folder.
-    if let Ok(d) = std::fs::File::open(dir) {
+    if durable && let Ok(d) = std::fs::File::open(dir) {
         let _ = d.sync_all();
     }
     Ok(())

@@ -50,7 +50,7 @@ pub fn build_id_noted(dir: &Path) -> &'static str {
         if let Some(folder) = note.parent()
             && std::fs::create_dir_all(folder).is_ok()
         {
-            let _ = crate::atomic::write_atomically_with(&note, |w| w.write_all(id.as_bytes()));
+            let _ = crate::atomic::write_entry_with(&note, |w| w.write_all(id.as_bytes()));
         }
         id
     })

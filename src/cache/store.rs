@@ -142,7 +142,7 @@ fn write_atomically(
         .parent()
         .ok_or_else(|| std::io::Error::other("an entry path has no folder"))?;
     std::fs::create_dir_all(dir)?;
-    crate::atomic::write_atomically_with(path, |w| write(w))
+    crate::atomic::write_entry_with(path, |w| write(w))
 }
 
 /// What a cache folder holds.
