@@ -1,7 +1,8 @@
 //! The one way framewright writes an output file: into a temporary file beside
 //! the target, flushed to disk, then renamed over it. An interrupted run (a
 //! signal, a full disk, an error half-way) leaves the previous file or none,
-//! never half a file; the temporary file is removed on error.
+//! never half a file; the temporary file is removed on error. Cache entries, which are
+//! checked when read, skip the flush (`write_entry_with`).
 
 use std::io::Write;
 use std::path::Path;
