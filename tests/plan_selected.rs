@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 /// How the plan is reasoned.
 #[derive(Clone, Copy, Debug)]
-enum Path_ {
+enum Route {
     /// Every relation converted, every offset a candidate, the rule base run twice.
     Before,
     /// Only the plan's relations, the rule base run twice.
@@ -30,11 +30,11 @@ enum Path_ {
 }
 
 /// `plan --json` of the model, reasoned along `path`.
-fn plan_json(model: &Model, cell: &Cell, path: Path_) -> Vec<u8> {
+fn plan_json(model: &Model, cell: &Cell, path: Route) -> Vec<u8> {
     let mut facts = model_facts(model, &Default::default());
     facts.extend(cell_facts(cell));
     let reasoned = match path {
-        Path_::Fused => reason_placed(
+        Route::Fused => reason_placed(
             facts,
             cell,
             &RuleEngine::Compiled,
@@ -42,8 +42,8 @@ fn plan_json(model: &Model, cell: &Cell, path: Path_) -> Vec<u8> {
             &RuleLimits::default(),
         )
         .expect("reason"),
-        Path_::Before | Path_::TwoPasses => {
-            let before = matches!(path, Path_::Before);
+        Route::Before | Route::TwoPasses => {
+            let before = matches!(path, Route::Before);
             let options = SearchOptions {
                 every_offset: before,
                 ..SearchOptions::default()
@@ -69,12 +69,12 @@ fn assert_same_plan(path: &Path, label: &str) {
     let model = Model::open(path).expect("read");
     for name in ["study-abb", "study-kuka"] {
         let cell = Cell::load(name).expect("cell");
-        let before = plan_json(&model, &cell, Path_::Before);
+        let before = plan_json(&model, &cell, Route::Before);
         assert!(
             String::from_utf8_lossy(&before).contains("\"wall_id\""),
             "{label}: the plan has walls"
         );
-        for path in [Path_::TwoPasses, Path_::Fused] {
+        for path in [Route::TwoPasses, Route::Fused] {
             assert!(
                 plan_json(&model, &cell, path) == before,
                 "{label}, {name}: the plan along {path:?} differs from the full conversion \
