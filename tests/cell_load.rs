@@ -232,3 +232,33 @@ fn pick_without_enough_margin_is_refused() {
         "{msg}"
     );
 }
+
+/// A nailer may lean a nail from 0 up to a toe nail's 30°; the study tool allows some lean.
+#[test]
+fn nail_lean_outside_0_to_30_degrees_is_refused() {
+    let study = include_str!("../robots/tools/study-gripper-nailer.toml");
+    assert!(Tool::study().max_nail_lean > 0.0);
+    for bad in ["45.0", "-5.0", "nan"] {
+        let text = study.replace("max_lean_deg = 20.0", &format!("max_lean_deg = {bad}"));
+        assert_ne!(text, study, "the study tool says max_lean_deg = 20.0");
+        let msg = Tool::parse(Path::new("lean.toml"), &text)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("lean.toml:")
+                && msg.contains("nailer.max_lean_deg")
+                && msg.contains("0 to 30"),
+            "{bad}: {msg}"
+        );
+    }
+    // Without a [nailer] table every nail is driven square.
+    let start = study.find("[nailer]").unwrap();
+    let end = study.find("max_lean_deg = 20.0").unwrap() + "max_lean_deg = 20.0".len();
+    let square = format!("{}{}", &study[..start], &study[end..]);
+    assert_eq!(
+        Tool::parse(Path::new("square.toml"), &square)
+            .unwrap()
+            .max_nail_lean,
+        0.0
+    );
+}

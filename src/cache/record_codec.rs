@@ -137,6 +137,8 @@ enum OutcomeBits {
         as_built: [u64; 3],
         position_error: u64,
         member_inside: bool,
+        driven: [u64; 3],
+        lean: u64,
     },
     Skipped {
         kind: String,
@@ -279,11 +281,15 @@ impl From<&WallRecord> for Rec {
                             as_built,
                             position_error,
                             member_inside,
+                            driven,
+                            lean,
                         } => OutcomeBits::Fired {
                             t: bits(*t),
                             as_built: as_built.map(bits),
                             position_error: bits(*position_error),
                             member_inside: *member_inside,
+                            driven: driven.map(bits),
+                            lean: bits(*lean),
                         },
                         NailOutcome::Skipped {
                             kind,
@@ -393,11 +399,15 @@ impl Rec {
                             as_built,
                             position_error,
                             member_inside,
+                            driven,
+                            lean,
                         } => NailOutcome::Fired {
                             t: float(t),
                             as_built: as_built.map(float),
                             position_error: float(position_error),
                             member_inside,
+                            driven: driven.map(float),
+                            lean: float(lean),
                         },
                         OutcomeBits::Skipped {
                             kind,

@@ -24,6 +24,31 @@ pub fn nail_rolls(point: &Point3<f64>, direction: &Vector3<f64>, base: &Point3<f
     rolls
 }
 
+/// The step between the leans tried, rad (5°).
+const LEAN_STEP: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
+/// The driving directions tried for a nail planned along `direction`, with their lean off it
+/// (rad): square first, then leaning in steps of at most 5° up to `max_lean`, the tip down
+/// before the tip up, in the vertical plane through the nail (lumber on edge is deepest
+/// that way). A vertical nail has no such plane and is driven square.
+pub fn nail_lines(direction: &Vector3<f64>, max_lean: f64) -> Vec<(Vector3<f64>, f64)> {
+    let d = direction.normalize();
+    let mut lines = vec![(d, 0.0)];
+    let up = Vector3::z() - d * d.z;
+    if max_lean <= 0.0 || up.norm() < 1e-6 {
+        return lines;
+    }
+    let up = up.normalize();
+    let steps = (max_lean / LEAN_STEP - 1e-9).ceil().max(1.0) as usize;
+    for k in 1..=steps {
+        let lean = max_lean * k as f64 / steps as f64;
+        for tip in [-up, up] {
+            lines.push(((d * lean.cos() + tip * lean.sin()).normalize(), lean));
+        }
+    }
+    lines
+}
+
 /// The nail TCP at `point` driving along `direction`, its x axis turned `roll` from up.
 pub fn nail_pose(point: &Point3<f64>, direction: &Vector3<f64>, roll: f64) -> Isometry3<f64> {
     let z = direction.normalize();
@@ -141,6 +166,25 @@ mod tests {
         assert!((g.translation.vector - Vector3::new(1.0, 0.5, 0.089)).norm() < 1e-12);
         assert!((g.rotation * Vector3::z() + Vector3::z()).norm() < 1e-12);
         assert!((g.rotation * Vector3::y() - Vector3::x()).norm() < 1e-12);
+    }
+
+    #[test]
+    fn nail_lines_lean_in_the_vertical_plane_square_first() {
+        let d = Vector3::new(-1.0, 0.0, 0.0);
+        assert_eq!(nail_lines(&d, 0.0), vec![(d, 0.0)]);
+        let lines = nail_lines(&d, 12f64.to_radians());
+        // Square, then 4°, 8°, 12°, each tip down then up.
+        assert_eq!(lines.len(), 7);
+        assert_eq!(lines[0], (d, 0.0));
+        for (k, (line, lean)) in lines.iter().enumerate().skip(1) {
+            let step = k.div_ceil(2);
+            assert!((lean - (4.0 * step as f64).to_radians()).abs() < 1e-12);
+            assert!((line.angle(&d) - lean).abs() < 1e-9, "{k}");
+            assert!(line.y.abs() < 1e-12, "stays in the vertical plane");
+            assert_eq!(line.z < 0.0, k % 2 == 1, "tip down first");
+        }
+        // A vertical nail is driven square.
+        assert_eq!(nail_lines(&-Vector3::z(), 0.3).len(), 1);
     }
 
     #[test]

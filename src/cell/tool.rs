@@ -11,6 +11,9 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+/// The steepest lean a tool file may allow: toe nails are driven at about 30° to the member.
+const MAX_LEAN_DEG: f64 = 30.0;
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ToolFile {
@@ -18,7 +21,14 @@ struct ToolFile {
     description: Option<String>,
     tcp: BTreeMap<String, FrameFile>,
     gripper: Option<GripperFile>,
+    nailer: Option<NailerFile>,
     parts: Vec<PartFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NailerFile {
+    max_lean_deg: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -107,6 +117,9 @@ pub struct Tool {
     #[serde(serialize_with = "serialize_frames")]
     pub tcps: BTreeMap<String, Isometry3<f64>>,
     pub gripper: Option<Gripper>,
+    /// How far (rad) a nail may lean off the planned line, tipped up or down in the vertical
+    /// plane through it, where the square nail is out of reach; 0 drives every nail square.
+    pub max_nail_lean: f64,
     /// Total mass, kg.
     pub mass: f64,
     /// Centre of mass in tool0, m (part shapes' centres weighted by part masses).
@@ -298,6 +311,24 @@ impl Tool {
                 Some(gripper)
             }
         };
+        let max_nail_lean = match file.nailer {
+            None => 0.0,
+            Some(n)
+                if n.max_lean_deg.is_finite() && (0.0..=MAX_LEAN_DEG).contains(&n.max_lean_deg) =>
+            {
+                n.max_lean_deg.to_radians()
+            }
+            Some(n) => {
+                return Err(bad(
+                    "nailer",
+                    "max_lean_deg",
+                    format!(
+                        "expected an angle from 0 to {MAX_LEAN_DEG} degrees (a nail leaning farther is a toe nail), got {}",
+                        n.max_lean_deg
+                    ),
+                ));
+            }
+        };
         let com = if mass > 0.0 {
             moment / mass
         } else {
@@ -312,6 +343,7 @@ impl Tool {
             parts,
             tcps,
             gripper,
+            max_nail_lean,
             mass,
             centre_of_mass: [com.x, com.y, com.z],
         })

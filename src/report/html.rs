@@ -311,13 +311,14 @@ fn validation(report: &SimReport) -> Markup {
         p { (format!("{} of {} nails driven and checked against the as-built pieces; largest error {:.2} mm ({:.2} %); ", v.checked, v.planned, v.max_error_mm, v.max_error_pct))
             (if v.all_inside_members { "every nail runs into its member." } else { "some nails miss their member." }) }
         table class="nails" {
-            tr { th { "wall" } th { "plate" } th { "member" } th { "k" } th { "planned u, v, w (m)" } th { "as built (m)" } th { "error (mm)" } th { "status" } }
+            tr { th { "wall" } th { "plate" } th { "member" } th { "k" } th { "planned u, v, w (m)" } th { "as built (m)" } th { "error (mm)" } th { "lean (°)" } th { "status" } }
             @for t in &v.targets {
                 tr {
                     td { (t.wall_id) } td { (t.plate) } td { (t.member) } td class="num" { (t.k) }
                     td class="num" { (format!("{:.4}, {:.4}, {:.4}", t.planned[0], t.planned[1], t.planned[2])) }
                     td class="num" { @if let Some(b) = t.as_built { (format!("{:.4}, {:.4}, {:.4}", b[0], b[1], b[2])) } @else { "–" } }
                     td class="num" { @if let Some(e) = t.error_mm { (format!("{e:.2}")) } @else { "–" } }
+                    td class="num" { @if let Some(l) = t.lean_deg { (format!("{l:.0}")) } @else { "–" } }
                     td { (t.status) }
                 }
             }

@@ -105,6 +105,9 @@ pub struct NailRow {
     pub error_mm: Option<f64>,
     pub error_pct: Option<f64>,
     pub member_inside: Option<bool>,
+    /// How far the nail was driven off its planned line (degrees; 0 when square); absent
+    /// when not driven.
+    pub lean_deg: Option<f64>,
     pub status: String,
 }
 
@@ -242,6 +245,7 @@ impl SimReport {
                         as_built,
                         position_error,
                         member_inside,
+                        lean,
                         ..
                     } => NailRow {
                         wall_id: wall_id(&rec.wall),
@@ -253,6 +257,7 @@ impl SimReport {
                         error_mm: Some(r6(position_error * 1000.0)),
                         error_pct: Some(r6(relative_error(&n.planned, as_built))),
                         member_inside: Some(*member_inside),
+                        lean_deg: Some(r6(lean.to_degrees())),
                         status: "fired".into(),
                     },
                     NailOutcome::Skipped { kind, .. } => NailRow {
@@ -265,6 +270,7 @@ impl SimReport {
                         error_mm: None,
                         error_pct: None,
                         member_inside: None,
+                        lean_deg: None,
                         status: format!("skipped: {kind}"),
                     },
                 };
@@ -437,8 +443,21 @@ impl SimReport {
 
     fn validation_line(&self) -> String {
         let v = &self.nailing_validation;
+        let leans: Vec<f64> = v
+            .targets
+            .iter()
+            .filter_map(|t| t.lean_deg)
+            .filter(|l| *l > 0.0)
+            .collect();
+        let leaning = match leans.len() {
+            0 => String::new(),
+            n => format!(
+                "; {n} driven leaning off square (up to {:.0}°)",
+                leans.iter().fold(0.0, |a: f64, b| a.max(*b))
+            ),
+        };
         format!(
-            "nailing validation: {} of {} nails driven and checked against the as-built pieces; max error {:.2} mm ({:.2} %); {}",
+            "nailing validation: {} of {} nails driven and checked against the as-built pieces; max error {:.2} mm ({:.2} %); {}{leaning}",
             v.checked,
             v.planned,
             v.max_error_mm,

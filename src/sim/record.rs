@@ -66,6 +66,10 @@ pub enum NailOutcome {
         as_built: [f64; 3],
         position_error: f64,
         member_inside: bool,
+        /// The line the nail was driven along (wall frame, unit vector) and its lean off the
+        /// planned line (rad; 0 when driven square).
+        driven: [f64; 3],
+        lean: f64,
     },
     Skipped {
         kind: String,
@@ -352,6 +356,8 @@ impl WallRecord {
                     as_built,
                     position_error,
                     member_inside,
+                    lean,
+                    ..
                 } => {
                     let mut fired = key();
                     fired.extend([
@@ -360,6 +366,9 @@ impl WallRecord {
                         Value::Number(i64::from(*member_inside)),
                     ]);
                     facts.add("sim_nail_fired", fired, origin());
+                    let mut leaning = key();
+                    leaning.push(f(*lean));
+                    facts.add("sim_nail_lean", leaning, origin());
                     let mut built = key();
                     built.extend(as_built.map(f));
                     facts.add("sim_nail_as_built", built, origin());

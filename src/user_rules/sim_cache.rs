@@ -29,6 +29,7 @@ pub const SIM_RELATIONS: &[(&str, &str)] = &[
     ("sim_grip_failed", "ss"),
     ("sim_nail", "ssnfff"),
     ("sim_nail_fired", "ssnffn"),
+    ("sim_nail_lean", "ssnf"),
     ("sim_nail_skipped", "ssnssffs"),
     ("sim_nail_as_built", "ssnfff"),
     ("sim_wall", "sfff"),

@@ -58,6 +58,7 @@ impl<'a> WallRun<'a> {
                 as_built,
                 position_error,
                 member_inside,
+                driven,
                 ..
             } = &mut record.outcome
             else {
@@ -81,21 +82,93 @@ impl<'a> WallRun<'a> {
             *position_error = (built - planned).norm();
             let b = wall_inv * built;
             *as_built = [b.x, b.y, b.z];
-            // A point past the plate, along the as-built nail line, must lie in the member.
-            let direction = plate_delta.rotation * (self.wall_cell.rotation * nail.direction);
+            // The nail as driven, carried by the as-built plate, must run into the member.
+            let direction =
+                plate_delta.rotation * (self.wall_cell.rotation * Vector3::from(*driven));
             let plate_pose = poses
                 .get(&record.plate)
                 .copied()
                 .unwrap_or_else(Isometry3::identity);
-            let local_dir = plate_pose.rotation.inverse() * direction;
-            let depth: f64 = (0..3).map(|i| local_dir[i].abs() * plate_size[i]).sum();
-            let tip = built + direction * (depth + 0.02);
             let member_size = sizes
                 .get(record.member.as_str())
                 .copied()
                 .unwrap_or([0.0; 3]);
-            let local = member_pose.inverse() * tip;
-            *member_inside = (0..3).all(|i| local[i].abs() <= member_size[i] / 2.0 + 5e-4);
+            *member_inside = nail_runs_into(
+                &built,
+                &direction,
+                (&plate_pose, plate_size),
+                (member_pose, &member_size),
+            );
         }
+    }
+}
+
+/// How far a nail reaches past the plate into the member (m) for the check below.
+const MEMBER_PENETRATION: f64 = 0.02;
+
+/// Whether a nail entering at `point` along `direction` (both in the cell frame) runs through
+/// the plate and on into the member: the point `MEMBER_PENETRATION` past where the line
+/// leaves the plate's box lies inside the member's box (0.5 mm tolerance). Poses are box
+/// centres with the boxes' full sizes.
+pub(super) fn nail_runs_into(
+    point: &Point3<f64>,
+    direction: &Vector3<f64>,
+    (plate_pose, plate_size): (&Isometry3<f64>, &[f64; 3]),
+    (member_pose, member_size): (&Isometry3<f64>, &[f64; 3]),
+) -> bool {
+    let local_point = plate_pose.inverse() * point;
+    let local_dir = plate_pose.rotation.inverse() * direction;
+    // Where the line leaves the plate's box (slab method; the point lies on or in it).
+    let exit = (0..3)
+        .filter(|&i| local_dir[i].abs() > 1e-12)
+        .map(|i| (plate_size[i] / 2.0 * local_dir[i].signum() - local_point[i]) / local_dir[i])
+        .fold(f64::INFINITY, f64::min)
+        .max(0.0);
+    let tip = point + direction * (exit + MEMBER_PENETRATION);
+    let local = member_pose.inverse() * tip;
+    (0..3).all(|i| local[i].abs() <= member_size[i] / 2.0 + 5e-4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Translation3, UnitQuaternion};
+
+    /// A 2x4 plate on edge along y (38 mm thick along x, 89 mm high) and a stud on edge along
+    /// x butting against it, as a wall lies on the floor; the nail enters the plate's outer
+    /// face at height `z`, driven along -x leaning `lean` (tip down when positive).
+    fn runs_into(z: f64, lean: f64, yaw: f64) -> bool {
+        let plate = Isometry3::from_parts(
+            Translation3::new(0.019, 0.0, 0.0445),
+            UnitQuaternion::identity(),
+        );
+        let stud = Isometry3::from_parts(
+            Translation3::new(-0.5, 0.0, 0.0445),
+            UnitQuaternion::identity(),
+        );
+        let direction = Vector3::new(-lean.cos() * yaw.cos(), yaw.sin(), -lean.sin());
+        nail_runs_into(
+            &Point3::new(0.038, 0.0, z),
+            &direction,
+            (&plate, &[0.038, 1.0, 0.089]),
+            (&stud, &[1.0, 0.038, 0.089]),
+        )
+    }
+
+    #[test]
+    fn a_square_or_moderately_leaning_nail_runs_into_the_member() {
+        assert!(runs_into(0.029, 0.0, 0.0));
+        assert!(runs_into(0.029, 15f64.to_radians(), 0.0));
+        assert!(runs_into(0.059, -15f64.to_radians(), 0.0));
+    }
+
+    #[test]
+    fn a_nail_leaving_the_member_is_caught() {
+        // 29 mm up, 0.066 m along a line leaning 35° down is 38 mm lower: below the stud.
+        assert!(!runs_into(0.029, 35f64.to_radians(), 0.0));
+        // Turned 25° sideways, 0.062 m along the line lies 26 mm off a 38 mm stud's centre.
+        assert!(!runs_into(0.029, 0.0, 25f64.to_radians()));
+        // Missing the stud altogether: a nail entering beside it.
+        assert!(!runs_into(0.100, 0.0, 0.0));
     }
 }

@@ -1,11 +1,13 @@
 //! Nailing: drive every nail of the plan whose plate and member were placed.
 
+use super::as_built::nail_runs_into;
 use super::{WallRun, failure_score};
+use crate::cell::Cell;
 use crate::cell::IkFailure;
-use crate::cell::tcp_poses::{nail_pose, nail_rolls, retreat};
+use crate::cell::tcp_poses::{nail_lines, nail_pose, nail_rolls, retreat};
 use crate::frame::plan::NailingTarget;
 use crate::sim::motion::LinearMove;
-use crate::sim::reach::{line, solve, touches};
+use crate::sim::reach::{line, touches};
 use crate::sim::record::{NailOutcome, NailRecord, failure_columns};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
@@ -20,9 +22,18 @@ pub(super) const NAIL_STANDOFF: f64 = 0.01;
 /// Where the nailer fires: its nose this far off the plate's face (m).
 pub(super) const NOSE_GAP: f64 = 0.002;
 
-/// A nail's firing pose, the pose its straight approach starts from, the joints there and
-/// the carriage position.
-type ChosenNail = (Isometry3<f64>, Isometry3<f64>, Vec<f64>, f64);
+/// How many approach poses of one nail the executor tries to move to before giving up.
+const MAX_PATH_TRIES: usize = 3;
+
+/// How a nail is driven, once the arm is at the start of its approach: the firing pose, the
+/// pose the straight approach starts from, and the line driven (cell frame) with its lean
+/// off the planned one (rad).
+struct ChosenNail {
+    pose: Isometry3<f64>,
+    back: Isometry3<f64>,
+    line: Vector3<f64>,
+    lean: f64,
+}
 
 /// One nail as the executor drives it.
 #[derive(Debug, Clone)]
@@ -96,37 +107,67 @@ impl<'a> WallRun<'a> {
             let direction = self.wall_cell.rotation * nail.direction;
             let mut chosen: Option<ChosenNail> = None;
             let mut miss: Option<(f64, IkFailure)> = None;
+            // When the nail operation began (the first move towards it).
+            let mut start: Option<f64> = None;
+            let mut path_tries = 0;
             // The nailer's roll turns its flange towards the base (on a track: the base
             // abeam of the nail).
             let base = match &self.cell.track {
                 Some(t) => Point3::from(t.base_at(t.abeam(&point)).translation.vector),
                 None => Point3::from(self.cell.robot_base.translation.vector),
             };
-            let rolls = nail_rolls(&point, &direction, &base);
-            let candidates = rolls.into_iter().flat_map(|roll| {
-                // The nose stops just short of the face: pressed against the work, the
-                // position-driven tool would shove the loose frame across the floor.
-                let pose = retreat(&nail_pose(&point, &direction, roll), NOSE_GAP);
-                nail_approaches(pose).map(move |back| (pose, back))
+            // Square first; then leaning as far as the tool allows, each lean only where
+            // the nail still runs through the plate into the member as planned.
+            let lines: Vec<(Vector3<f64>, f64)> =
+                nail_lines(&direction, self.cell.tool.max_nail_lean)
+                    .into_iter()
+                    .filter(|(line, lean)| {
+                        *lean == 0.0 || self.runs_into_as_planned(nail, &point, line)
+                    })
+                    .collect();
+            let candidates = lines.iter().flat_map(|&(driven, lean)| {
+                nail_rolls(&point, &driven, &base)
+                    .into_iter()
+                    .flat_map(move |roll| {
+                        // The nose stops just short of the face: pressed against the work, the
+                        // position-driven tool would shove the loose frame across the floor.
+                        let pose = retreat(&nail_pose(&point, &driven, roll), NOSE_GAP);
+                        nail_approaches(pose).map(move |back| (pose, back, driven, lean))
+                    })
             });
-            for (pose, back) in candidates {
+            for (pose, back, driven, lean) in candidates {
                 let attempt = self
                     .carriage_for(self.cell.carriage(), &[(back, nail_tcp), (pose, nail_tcp)])
                     .and_then(|s| {
                         let at = self.cell_at(s);
-                        let qa = solve(&at, &back, &nail_tcp, &self.q)?;
-                        let q_nail = line(&at, &qa, &back, &pose, &nail_tcp, 4)?;
-                        let ignore = [nail.plate.as_str(), nail.member.as_str()];
-                        match touches(&self.phys, &at, &q_nail, None, &ignore, 0.0)
-                            .or_else(|| touches(&self.phys, &at, &qa, None, &ignore, 0.0))
-                        {
-                            Some((a, b)) => Err(IkFailure::AllSolutionsCollide { pair: [a, b] }),
-                            None => Ok((qa, s)),
-                        }
+                        self.clear_nail_branch(&at, nail, (&back, &pose), &nail_tcp)
+                            .map(|qa| (qa, s))
                     });
                 match attempt {
                     Ok((q_back, s)) => {
-                        chosen = Some((pose, back, q_back, s));
+                        // Go to the approach pose; where no way leads there, try the next
+                        // pose (a few at most: each costs the planner's budget).
+                        if start.is_none() {
+                            start = Some(self.begin(&nail.plate, "nail", &[nail.member.as_str()]));
+                        }
+                        if let Err(f) = self.move_carriage(s, &nail_tcp, &[]).and_then(|()| {
+                            self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed())
+                        }) {
+                            // Reachable and clear, only the way there is blocked: the most
+                            // telling miss.
+                            miss = Some((-2.0, f));
+                            path_tries += 1;
+                            if path_tries == MAX_PATH_TRIES {
+                                break;
+                            }
+                            continue;
+                        }
+                        chosen = Some(ChosenNail {
+                            pose,
+                            back,
+                            line: driven,
+                            lean,
+                        });
                         break;
                     }
                     Err(f) => {
@@ -137,23 +178,23 @@ impl<'a> WallRun<'a> {
                     }
                 }
             }
-            let Some((pose, back, q_back, carriage)) = chosen else {
+            let plate = nail.plate.clone();
+            let Some(ChosenNail {
+                pose,
+                back,
+                line,
+                lean,
+            }) = chosen
+            else {
+                if let Some(start) = start {
+                    self.end(&plate, "nail", start);
+                }
                 let failure = miss.map_or(IkFailure::InvalidPose, |m| m.1);
                 let (kind, what, value, limit) = failure_columns(&failure);
                 self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
                 continue;
             };
-            let plate = nail.plate.clone();
-            let start = self.begin(&plate, "nail", &[nail.member.as_str()]);
-            if let Err(failure) = self
-                .move_carriage(carriage, &nail_tcp, &[])
-                .and_then(|()| self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()))
-            {
-                self.end(&plate, "nail", start);
-                let (kind, what, value, limit) = failure_columns(&failure);
-                self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
-                continue;
-            }
+            let start = start.unwrap_or(self.t);
             let reached = self
                 .run_line(
                     &LinearMove::new(
@@ -191,6 +232,8 @@ impl<'a> WallRun<'a> {
                         as_built: nail.uvw,
                         position_error: f64::NAN,
                         member_inside: false,
+                        driven: (self.wall_cell.rotation.inverse() * line).into(),
+                        lean,
                     },
                 });
             } else {
@@ -203,6 +246,53 @@ impl<'a> WallRun<'a> {
                     "the nailer lost the straight line to the nail".into(),
                 );
             }
+        }
+    }
+
+    /// The joints at `back` of the first IK solution there (nearest the arm's joints first)
+    /// whose straight line to `fire` exists without a jump and touches nothing at either
+    /// end: firing, the nose may touch the plate and the member; at `back` nothing may.
+    fn clear_nail_branch(
+        &self,
+        at: &Cell,
+        nail: &NailPlan,
+        (back, fire): (&Isometry3<f64>, &Isometry3<f64>),
+        tcp: &Isometry3<f64>,
+    ) -> Result<Vec<f64>, IkFailure> {
+        let ignore = [nail.plate.as_str(), nail.member.as_str()];
+        let mut first: Option<IkFailure> = None;
+        let mut collision: Option<IkFailure> = None;
+        for qa in at.robot.ik(&at.to_robot(back), tcp, &self.q)? {
+            match line(at, &qa, back, fire, tcp, 4) {
+                Ok(q_fire) => match touches(&self.phys, at, &q_fire, None, &ignore, 0.0)
+                    .or_else(|| touches(&self.phys, at, &qa, None, &[], 0.0))
+                {
+                    None => return Ok(qa),
+                    Some((a, b)) => {
+                        collision.get_or_insert(IkFailure::AllSolutionsCollide { pair: [a, b] });
+                    }
+                },
+                Err(f) => {
+                    first.get_or_insert(f);
+                }
+            }
+        }
+        // A solution that got there but collides is the more telling miss.
+        Err(collision.or(first).unwrap_or(IkFailure::InvalidPose))
+    }
+
+    /// Whether a nail entering at `point` along `line` (cell frame) runs through its plate into
+    /// its member where both were placed.
+    fn runs_into_as_planned(
+        &self,
+        nail: &NailPlan,
+        point: &Point3<f64>,
+        line: &Vector3<f64>,
+    ) -> bool {
+        let piece = |id: &str| Some((self.placed.get(id)?, self.sizes.get(id)?));
+        match (piece(&nail.plate), piece(&nail.member)) {
+            (Some(plate), Some(member)) => nail_runs_into(point, line, plate, member),
+            _ => false,
         }
     }
 
@@ -232,13 +322,14 @@ impl<'a> WallRun<'a> {
 }
 
 /// Where the nailer starts its straight approach to a nail pose, in the order tried: back
-/// along the nail line, then (for a nail not driven vertically) from above, just off the face.
+/// along the nail line, then (for a nail not driven steeply down or up) straight above the
+/// nail, just off the face.
 fn nail_approaches(pose: Isometry3<f64>) -> impl Iterator<Item = Isometry3<f64>> {
     let along = retreat(&pose, NAIL_APPROACH);
     let drive = pose.rotation * Vector3::z();
-    let up = Vector3::z() - drive * drive.z;
-    let from_above = (up.norm() > 0.5).then(|| {
-        let lift = up.normalize() * NAIL_DESCENT;
+    let from_above = (drive.z.abs() < 0.75f64.sqrt()).then(|| {
+        // Straight up (not square to a leaning nail, which would swing the nose over the face).
+        let lift = Vector3::z() * NAIL_DESCENT;
         let off = retreat(&pose, NAIL_STANDOFF);
         Isometry3::from_parts(
             Translation3::from(off.translation.vector + lift),
