@@ -103,98 +103,26 @@ impl<'a> WallRun<'a> {
                 );
                 continue;
             }
-            let point = self.wall_cell * Point3::from(Vector3::from(nail.uvw));
-            let direction = self.wall_cell.rotation * nail.direction;
-            let mut chosen: Option<ChosenNail> = None;
-            let mut miss: Option<(f64, IkFailure)> = None;
-            // When the nail operation began (the first move towards it).
-            let mut start: Option<f64> = None;
-            let mut path_tries = 0;
-            // The nailer's roll turns its flange towards the base (on a track: the base
-            // abeam of the nail).
-            let base = match &self.cell.track {
-                Some(t) => Point3::from(t.base_at(t.abeam(&point)).translation.vector),
-                None => Point3::from(self.cell.robot_base.translation.vector),
-            };
-            // Square first; then leaning as far as the tool allows, each lean only where
-            // the nail still runs through the plate into the member as planned.
-            let lines: Vec<(Vector3<f64>, f64)> =
-                nail_lines(&direction, self.cell.tool.max_nail_lean)
-                    .into_iter()
-                    .filter(|(line, lean)| {
-                        *lean == 0.0 || self.runs_into_as_planned(nail, &point, line)
-                    })
-                    .collect();
-            let candidates = lines.iter().flat_map(|&(driven, lean)| {
-                nail_rolls(&point, &driven, &base)
-                    .into_iter()
-                    .flat_map(move |roll| {
-                        // The nose stops just short of the face: pressed against the work, the
-                        // position-driven tool would shove the loose frame across the floor.
-                        let pose = retreat(&nail_pose(&point, &driven, roll), NOSE_GAP);
-                        nail_approaches(pose).map(move |back| (pose, back, driven, lean))
-                    })
-            });
-            for (pose, back, driven, lean) in candidates {
-                let attempt = self
-                    .carriage_for(self.cell.carriage(), &[(back, nail_tcp), (pose, nail_tcp)])
-                    .and_then(|s| {
-                        let at = self.cell_at(s);
-                        self.clear_nail_branch(&at, nail, (&back, &pose), &nail_tcp)
-                            .map(|qa| (qa, s))
-                    });
-                match attempt {
-                    Ok((q_back, s)) => {
-                        // Go to the approach pose; where no way leads there, try the next
-                        // pose (a few at most: each costs the planner's budget).
-                        if start.is_none() {
-                            start = Some(self.begin(&nail.plate, "nail", &[nail.member.as_str()]));
-                        }
-                        if let Err(f) = self.move_carriage(s, &nail_tcp, &[]).and_then(|()| {
-                            self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed())
-                        }) {
-                            // Reachable and clear, only the way there is blocked: the most
-                            // telling miss.
-                            miss = Some((-2.0, f));
-                            path_tries += 1;
-                            if path_tries == MAX_PATH_TRIES {
-                                break;
-                            }
-                            continue;
-                        }
-                        chosen = Some(ChosenNail {
-                            pose,
-                            back,
-                            line: driven,
-                            lean,
-                        });
-                        break;
-                    }
-                    Err(f) => {
-                        let score = failure_score(&f);
-                        if miss.as_ref().is_none_or(|m| score < m.0) {
-                            miss = Some((score, f));
-                        }
-                    }
-                }
-            }
             let plate = nail.plate.clone();
-            let Some(ChosenNail {
-                pose,
-                back,
-                line,
-                lean,
-            }) = chosen
-            else {
-                if let Some(start) = start {
-                    self.end(&plate, "nail", start);
+            let (
+                start,
+                ChosenNail {
+                    pose,
+                    back,
+                    line,
+                    lean,
+                },
+            ) = match self.approach_nail(nail, &nail_tcp) {
+                Ok(chosen) => chosen,
+                Err((start, failure)) => {
+                    if let Some(start) = start {
+                        self.end(&plate, "nail", start);
+                    }
+                    let (kind, what, value, limit) = failure_columns(&failure);
+                    self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
+                    continue;
                 }
-                let failure = miss.map_or(IkFailure::InvalidPose, |m| m.1);
-                let (kind, what, value, limit) = failure_columns(&failure);
-                self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
-                continue;
             };
-            let start = start.unwrap_or(self.t);
             let reached = self
                 .run_line(
                     &LinearMove::new(
@@ -247,6 +175,92 @@ impl<'a> WallRun<'a> {
                 );
             }
         }
+    }
+
+    /// Chooses how to drive `nail` (square first, then leaning; every roll and approach) and
+    /// moves the arm to the start of its approach: when the nail operation began (at the
+    /// first move towards it), and the chosen pose or the most telling miss.
+    fn approach_nail(
+        &mut self,
+        nail: &NailPlan,
+        nail_tcp: &Isometry3<f64>,
+    ) -> Result<(f64, ChosenNail), (Option<f64>, IkFailure)> {
+        let nail_tcp = *nail_tcp;
+        let point = self.wall_cell * Point3::from(Vector3::from(nail.uvw));
+        let direction = self.wall_cell.rotation * nail.direction;
+        let mut miss: Option<(f64, IkFailure)> = None;
+        // When the nail operation began (the first move towards it).
+        let mut start: Option<f64> = None;
+        let mut path_tries = 0;
+        // The nailer's roll turns its flange towards the base (on a track: the base
+        // abeam of the nail).
+        let base = match &self.cell.track {
+            Some(t) => Point3::from(t.base_at(t.abeam(&point)).translation.vector),
+            None => Point3::from(self.cell.robot_base.translation.vector),
+        };
+        // Square first; then leaning as far as the tool allows, each lean only where
+        // the nail still runs through the plate into the member as planned.
+        let lines: Vec<(Vector3<f64>, f64)> = nail_lines(&direction, self.cell.tool.max_nail_lean)
+            .into_iter()
+            .filter(|(line, lean)| *lean == 0.0 || self.runs_into_as_planned(nail, &point, line))
+            .collect();
+        let candidates = lines.iter().flat_map(|&(driven, lean)| {
+            nail_rolls(&point, &driven, &base)
+                .into_iter()
+                .flat_map(move |roll| {
+                    // The nose stops just short of the face: pressed against the work, the
+                    // position-driven tool would shove the loose frame across the floor.
+                    let pose = retreat(&nail_pose(&point, &driven, roll), NOSE_GAP);
+                    nail_approaches(pose).map(move |back| (pose, back, driven, lean))
+                })
+        });
+        for (pose, back, driven, lean) in candidates {
+            let attempt = self
+                .carriage_for(self.cell.carriage(), &[(back, nail_tcp), (pose, nail_tcp)])
+                .and_then(|s| {
+                    let at = self.cell_at(s);
+                    self.clear_nail_branch(&at, nail, (&back, &pose), &nail_tcp)
+                        .map(|qa| (qa, s))
+                });
+            match attempt {
+                Ok((q_back, s)) => {
+                    // Go to the approach pose; where no way leads there, try the next
+                    // pose (a few at most: each costs the planner's budget).
+                    let begun = *start.get_or_insert_with(|| {
+                        self.begin(&nail.plate, "nail", &[nail.member.as_str()])
+                    });
+                    if let Err(f) = self
+                        .move_carriage(s, &nail_tcp, &[])
+                        .and_then(|()| self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()))
+                    {
+                        // Reachable and clear, only the way there is blocked: the most
+                        // telling miss.
+                        miss = Some((-2.0, f));
+                        path_tries += 1;
+                        if path_tries == MAX_PATH_TRIES {
+                            break;
+                        }
+                        continue;
+                    }
+                    return Ok((
+                        begun,
+                        ChosenNail {
+                            pose,
+                            back,
+                            line: driven,
+                            lean,
+                        },
+                    ));
+                }
+                Err(f) => {
+                    let score = failure_score(&f);
+                    if miss.as_ref().is_none_or(|m| score < m.0) {
+                        miss = Some((score, f));
+                    }
+                }
+            }
+        }
+        Err((start, miss.map_or(IkFailure::InvalidPose, |m| m.1)))
     }
 
     /// The joints at `back` of the first IK solution there (nearest the arm's joints first)
