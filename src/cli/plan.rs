@@ -50,13 +50,14 @@ pub fn run(args: PlanArgs) -> CmdResult {
         }
     };
     warn_if_unwritable(cache.as_ref());
-    let mut report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
+    let plan = Plan::from_reasoned(&model, &reasoned);
+    let mut report = PlanReport::new(&model, &plan);
     report.cache = counts;
     let written = if args.json {
         write_stdout(|out| report.write_json(&mut &mut *out))
     } else {
         print_stdout(&report.to_text())
     };
-    leave_to_exit((model, reasoned, report));
+    leave_to_exit((model, reasoned, plan, report));
     written
 }

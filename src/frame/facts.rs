@@ -74,38 +74,23 @@ impl Facts {
     /// it, and facts about no piece (the cell) to every part. Walls never span
     /// containers, so each part can be reasoned on its own.
     pub fn by_container(&self) -> Vec<Relations> {
-        let mut part_names: FxHashMap<&str, usize> = FxHashMap::default();
-        let mut part_of_piece: FxHashMap<&str, usize> = FxHashMap::default();
-        for (t, _) in self.tuples.get("piece_container").into_iter().flatten() {
-            if let (Some(p), Some(c)) = (t[0].as_symbol(), t[1].as_symbol()) {
-                let next = part_names.len();
-                part_of_piece.insert(p, *part_names.entry(c).or_insert(next));
-            }
-        }
-        let n = part_names.len().max(1);
-        let part_of = |v: Option<&Value>| {
-            v.and_then(Value::as_symbol)
-                .and_then(|p| part_of_piece.get(p).copied())
-        };
-        let mut parts: Vec<Relations> = vec![Relations::new(); n];
-        for (name, tuples) in &self.tuples {
-            let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); n];
-            for (tuple, _) in tuples {
-                match part_of(tuple.first()) {
-                    Some(k) if *name == "contact" => {
-                        if part_of(tuple.get(1)) == Some(k) {
-                            buckets[k].push(tuple.clone());
-                        }
-                    }
-                    Some(k) => buckets[k].push(tuple.clone()),
-                    None => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
-                }
-            }
-            for (part, bucket) in parts.iter_mut().zip(buckets) {
-                part.insert(name.to_string(), bucket);
-            }
-        }
-        parts
+        split_by_container(
+            self.tuples
+                .iter()
+                .map(|(name, tuples)| (*name, tuples.iter().map(|(t, _)| t.clone()).collect()))
+                .collect(),
+        )
+    }
+
+    /// `by_container`, moving the tuples instead of copying them (only the facts about
+    /// no piece are copied, once per part); their origins are dropped.
+    pub fn into_by_container(self) -> Vec<Relations> {
+        split_by_container(
+            self.tuples
+                .into_iter()
+                .map(|(name, tuples)| (name, tuples.into_iter().map(|(t, _)| t).collect()))
+                .collect(),
+        )
     }
 
     /// Inserts every tuple into an interpreter (relations the program does not declare are skipped).
@@ -120,6 +105,67 @@ impl Facts {
         }
         Ok(())
     }
+}
+
+/// `Facts::by_container` on tuples without origins.
+fn split_by_container(mut tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Vec<Relations> {
+    let mut part_names: FxHashMap<&str, usize> = FxHashMap::default();
+    let mut part_of_piece: FxHashMap<&str, usize> = FxHashMap::default();
+    for t in tuples.get("piece_container").into_iter().flatten() {
+        if let (Some(p), Some(c)) = (t[0].as_symbol(), t[1].as_symbol()) {
+            let next = part_names.len();
+            part_of_piece.insert(p, *part_names.entry(c).or_insert(next));
+        }
+    }
+    let n = part_names.len().max(1);
+    let part_of = |v: Option<&Value>| {
+        v.and_then(Value::as_symbol)
+            .and_then(|p| part_of_piece.get(p).copied())
+    };
+    // Where each tuple goes, decided while the piece names are borrowed.
+    let destinations: Vec<(&'static str, Vec<Destination>)> = tuples
+        .iter()
+        .map(|(name, tuples)| {
+            let to = tuples
+                .iter()
+                .map(|tuple| match part_of(tuple.first()) {
+                    Some(k) if *name == "contact" => {
+                        if part_of(tuple.get(1)) == Some(k) {
+                            Destination::Part(k)
+                        } else {
+                            Destination::Nowhere
+                        }
+                    }
+                    Some(k) => Destination::Part(k),
+                    None => Destination::Every,
+                })
+                .collect();
+            (*name, to)
+        })
+        .collect();
+    let mut parts: Vec<Relations> = vec![Relations::new(); n];
+    for (name, to) in destinations {
+        let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); n];
+        for (tuple, to) in tuples.remove(name).unwrap_or_default().into_iter().zip(to) {
+            match to {
+                Destination::Part(k) => buckets[k].push(tuple),
+                Destination::Every => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
+                Destination::Nowhere => {}
+            }
+        }
+        for (part, bucket) in parts.iter_mut().zip(buckets) {
+            part.insert(name.to_string(), bucket);
+        }
+    }
+    parts
+}
+
+/// The part a fact goes to in `split_by_container`.
+#[derive(Clone, Copy)]
+enum Destination {
+    Part(usize),
+    Every,
+    Nowhere,
 }
 
 fn sym(s: &str) -> Value {

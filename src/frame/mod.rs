@@ -175,18 +175,20 @@ fn reason_compiled(
     selected: Option<&[&str]>,
     limits: &RuleLimits,
 ) -> Result<Relations, FrameError> {
-    reason_compiled_placing(facts, selected, limits, None)
+    reason_compiled_placing(facts.by_container(), selected, limits, None)
 }
 
 /// The placement search for one part: the first pass's relations (`placement::FIRST_PASS`)
 /// in, the part's placement facts out.
 pub(crate) type PlaceFn<'a> = &'a (dyn Fn(&Relations) -> Relations + Sync);
 
-/// `reason_compiled`; with `place` (and `selected`, which the typed runner must handle),
+/// `reason_compiled` on the facts already split by container (`Facts::by_container`, or
+/// `into_by_container` by a caller done with its facts); with `place` (and `selected`,
+/// which the typed runner must handle),
 /// each part's placement facts come from `place` between a first pass and the rules they
 /// reach (`compiled::builtin::run_placed`).
 pub(crate) fn reason_compiled_placing(
-    facts: &Facts,
+    mut parts: Vec<Relations>,
     selected: Option<&[&str]>,
     limits: &RuleLimits,
     place: Option<PlaceFn>,
@@ -195,7 +197,6 @@ pub(crate) fn reason_compiled_placing(
     use std::sync::atomic::{AtomicU64, Ordering};
     let run = compiled::program("rules")
         .ok_or_else(|| FrameError::Compiled("no compiled rule base".into()))?;
-    let mut parts = facts.by_container();
     // Largest first, so the parallel runs finish together.
     parts.sort_by_key(|p| std::cmp::Reverse(p.get("piece").map_or(0, Vec::len)));
     let wanted: Option<Vec<&str>> = selected.map(|names| {

@@ -113,8 +113,8 @@ pub fn reason_placed(
     let memo = SearchMemo::default();
     let options = SearchOptions::default();
     let place = |first: &Relations| placement_relations(cell, first, (min, max), &options, &memo);
-    let relations = reason_compiled_placing(&facts, Some(selected), limits, Some(&place))?;
-    drop(facts);
+    let parts = facts.into_by_container();
+    let relations = reason_compiled_placing(parts, Some(selected), limits, Some(&place))?;
     let reasoned = Reasoned {
         relations,
         engine: None,

@@ -12,6 +12,7 @@ use super::shape::{self, item_shape, world_box};
 use super::units::{LengthUnit, length_unit};
 use crate::geom::{OrientedBox, Point3};
 use crate::step::{Entity, Record};
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// One lumber piece: a solid body item of a product, as a world-frame box.
@@ -77,6 +78,9 @@ pub(crate) struct Read {
     pub warnings: Vec<Warning>,
 }
 
+/// The pieces and warnings of one run of products.
+type Run = (Vec<Piece>, Vec<Warning>);
+
 pub(crate) fn read(mut ctx: Ctx<'_>) -> Result<Read, IfcErrorKind> {
     let unit = match length_unit(&ctx) {
         Ok(unit) => unit,
@@ -94,27 +98,48 @@ pub(crate) fn read(mut ctx: Ctx<'_>) -> Result<Read, IfcErrorKind> {
     };
     ctx.scale = unit.metres_per_unit;
     let relations = Relations::read(&ctx).map_err(fatal)?;
-    let mut placements = Placements::default();
     let mut records: Vec<&Record> = LUMBER_PRODUCTS
         .iter()
         .flat_map(|t| ctx.file.of_type(t))
         .collect();
     records.sort_by_key(|r| r.start);
 
+    // Products are read in parallel runs, each with its own placement cache and warnings;
+    // the runs are joined in file order, and the first fatal issue in file order stops the
+    // read, as one pass would.
+    let chunk = records
+        .len()
+        .div_ceil(rayon::current_num_threads() * 8)
+        .max(64);
+    let runs: Vec<Result<Run, IfcErrorKind>> = records
+        .par_chunks(chunk)
+        .map(|run| {
+            let ctx = Ctx::new(ctx.file, ctx.schema, ctx.scale);
+            let mut placements = Placements::default();
+            let mut pieces = Vec::new();
+            for record in run {
+                let product = ctx.file.decode(record).map_err(IfcErrorKind::Step)?;
+                match product_pieces(&ctx, &relations, &mut placements, &product) {
+                    Ok(found) => pieces.extend(found),
+                    Err(Issue::Fatal(kind)) => return Err(kind),
+                    Err(issue) => ctx.warn(
+                        Some(product.id),
+                        format!("{} skipped: {}", describe(&ctx, &product), issue.describe()),
+                    ),
+                }
+            }
+            Ok((pieces, ctx.take_warnings()))
+        })
+        .collect();
     let mut pieces = Vec::new();
-    for record in records {
-        let product = ctx.file.decode(record).map_err(IfcErrorKind::Step)?;
-        match product_pieces(&ctx, &relations, &mut placements, &product) {
-            Ok(found) => pieces.extend(found),
-            Err(Issue::Fatal(kind)) => return Err(kind),
-            Err(issue) => ctx.warn(
-                Some(product.id),
-                format!("{} skipped: {}", describe(&ctx, &product), issue.describe()),
-            ),
-        }
+    let mut warnings = Vec::new();
+    for run in runs {
+        let (found, warned) = run?;
+        pieces.extend(found);
+        warnings.extend(warned);
     }
     let groups = groups_of(&ctx, &relations, &pieces).map_err(fatal)?;
-    let mut warnings = ctx.take_warnings();
+    warnings.extend(ctx.take_warnings());
     warnings.sort();
     warnings.dedup();
     Ok(Read {

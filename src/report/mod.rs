@@ -9,6 +9,7 @@ pub mod markup_text;
 mod mesh;
 pub mod plan;
 pub mod png;
+mod pretty_json;
 pub mod simulate;
 pub mod svg;
 pub mod verdict;

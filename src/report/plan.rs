@@ -91,6 +91,7 @@ fn unit(x: f64) -> f64 {
 
 impl PlanReport {
     pub fn new(model: &Model, plan: &Plan) -> PlanReport {
+        use rayon::prelude::*;
         let frames: BTreeMap<&str, &nalgebra::Isometry3<f64>> = plan
             .walls
             .iter()
@@ -98,7 +99,7 @@ impl PlanReport {
             .collect();
         let members = model
             .pieces()
-            .iter()
+            .par_iter()
             .map(|p| {
                 let wall_id = plan.wall_of.get(&p.id).cloned();
                 let (mut start, mut end) = p.axis();
@@ -131,7 +132,7 @@ impl PlanReport {
             .collect();
         let walls = plan
             .walls
-            .iter()
+            .par_iter()
             .map(|w| {
                 let m = w.frame.to_homogeneous();
                 let frame_matrix = [0, 1, 2, 3].map(|i| {
@@ -222,8 +223,25 @@ impl PlanReport {
     }
 
     pub fn write_json(&self, out: &mut impl std::io::Write) -> std::io::Result<()> {
-        serde_json::to_writer_pretty(&mut *out, self)?;
-        out.write_all(b"\n")
+        use super::pretty_json::{Array, write_pretty};
+        // The members and walls are rendered in parallel into the rest of the report.
+        let skeleton = PlanReport {
+            schema: self.schema.clone(),
+            length_unit: self.length_unit.clone(),
+            members: Vec::new(),
+            walls: Vec::new(),
+            warnings: self.warnings.clone(),
+            cache: self.cache,
+        };
+        let members = Array {
+            key: "members",
+            items: &self.members,
+        };
+        let walls = Array {
+            key: "walls",
+            items: &self.walls,
+        };
+        write_pretty(out, &skeleton, (members, walls))
     }
 
     /// One line per wall: name, size, counts by role; then warnings.
