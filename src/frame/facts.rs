@@ -191,117 +191,167 @@ pub fn obox_value(b: &OrientedBox) -> Value {
 }
 
 /// The facts of a model: pieces, their boxes, groups, containers, materials and contacts.
+/// Built in parallel runs of pieces and of contacts, joined in order: the same tuples in the
+/// same order as one pass.
 pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
+    use rayon::prelude::*;
+    let pieces = model.pieces();
+    let ids: Vec<Value> = pieces.par_iter().map(|p| sym(&p.id)).collect();
+    let per_run = |n: usize| n.div_ceil(rayon::current_num_threads() * 8).max(256);
+    let piece_runs: Vec<Facts> = pieces
+        .par_chunks(per_run(pieces.len()))
+        .zip(ids.par_chunks(per_run(pieces.len())))
+        .enumerate()
+        .map(|(run, (pieces_of_run, ids_of_run))| {
+            let first = run * per_run(pieces.len());
+            let mut facts = Facts::default();
+            // Names that repeat (types, materials, containers) share one symbol.
+            let mut names = Symbols::default();
+            for (k, (p, id)) in pieces_of_run.iter().zip(ids_of_run).enumerate() {
+                add_piece_facts(&mut facts, &mut names, model, first + k, p, id);
+            }
+            facts
+        })
+        .collect();
+    let boxes: Vec<OrientedBox> = pieces.iter().map(|p| p.obox).collect();
+    let found = contacts(&boxes, contact_options);
+    let contact_runs: Vec<Facts> = found
+        .par_chunks(per_run(found.len()))
+        .map(|run| {
+            let mut facts = Facts::default();
+            let mut names = Symbols::default();
+            for c in run {
+                add_contact_facts(&mut facts, &mut names, model, &ids, c);
+            }
+            facts
+        })
+        .collect();
     let mut facts = Facts::default();
-    // Names that repeat (types, materials, containers, contact kinds) share one symbol.
-    let mut names = Symbols::default();
-    let ids: Vec<Value> = model.pieces().iter().map(|p| sym(&p.id)).collect();
-    for (index, p) in model.pieces().iter().enumerate() {
-        let origin = Origin::Entity(p.entity);
-        let id = ids[index].clone();
-        facts.add(
-            "piece",
-            vec![
-                id.clone(),
-                Value::Number(p.entity as i64),
-                names.get(&p.ifc_type),
-                names.text(&p.name),
-            ],
-            origin.clone(),
-        );
-        facts.add(
-            "piece_box",
-            vec![id.clone(), obox_value(&p.obox)],
-            Origin::Entity(p.item),
-        );
-        facts.add(
-            "piece_size",
-            vec![
-                id.clone(),
-                Value::float(p.obox.length()),
-                Value::float(p.obox.width()),
-                Value::float(p.obox.thickness()),
-            ],
-            Origin::Entity(p.item),
-        );
-        facts.add(
-            "piece_index",
-            vec![id.clone(), Value::Number(index as i64)],
-            origin.clone(),
-        );
-        facts.add(
-            "piece_type",
-            vec![
-                id.clone(),
-                names.text(&p.predefined_type),
-                names.text(&p.object_type),
-            ],
-            origin.clone(),
-        );
-        if let Some(group) = p.parent.and_then(|g| model.groups.get(&g)) {
-            facts.add(
-                "piece_group",
-                vec![
-                    id.clone(),
-                    names.get(&group.global_id),
-                    names.get(&group.ifc_type),
-                    names.text(&group.name),
-                ],
-                Origin::Entity(group.entity),
-            );
+    for run in piece_runs.into_iter().chain(contact_runs) {
+        for (relation, tuples) in run.tuples {
+            facts.tuples.entry(relation).or_default().extend(tuples);
         }
-        let container = p.container.and_then(|c| model.groups.get(&c));
-        facts.add(
-            "piece_container",
-            vec![
-                id.clone(),
-                names.get(container.map_or("", |c| c.global_id.as_str())),
-            ],
-            container.map_or(origin.clone(), |c| Origin::Entity(c.entity)),
-        );
-        let (density, _) = density_of(p.material.as_deref());
-        facts.add(
-            "piece_material",
-            vec![id.clone(), names.text(&p.material), Value::float(density)],
-            origin,
-        );
-    }
-    let boxes: Vec<OrientedBox> = model.pieces().iter().map(|p| p.obox).collect();
-    for c in contacts(&boxes, contact_options) {
-        let (a, b) = (&model.pieces()[c.a], &model.pieces()[c.b]);
-        let origin = Origin::Entity(a.entity);
-        let kind = names.get(c.kind.name());
-        let (face_a, face_b) = (names.get(c.face_a.name()), names.get(c.face_b.name()));
-        facts.add(
-            "contact",
-            vec![
-                ids[c.a].clone(),
-                ids[c.b].clone(),
-                kind.clone(),
-                face_a.clone(),
-                face_b.clone(),
-                Value::float(c.gap),
-                vec3(&c.normal),
-                vec3(&c.centre.coords),
-            ],
-            origin.clone(),
-        );
-        facts.add(
-            "contact",
-            vec![
-                ids[c.b].clone(),
-                ids[c.a].clone(),
-                kind,
-                face_b,
-                face_a,
-                Value::float(c.gap),
-                vec3(&-c.normal),
-                vec3(&c.centre.coords),
-            ],
-            Origin::Entity(b.entity),
-        );
     }
     facts
+}
+
+/// The facts of piece `index` of the model.
+fn add_piece_facts(
+    facts: &mut Facts,
+    names: &mut Symbols,
+    model: &Model,
+    index: usize,
+    p: &crate::ifc::Piece,
+    id: &Value,
+) {
+    let origin = Origin::Entity(p.entity);
+    facts.add(
+        "piece",
+        vec![
+            id.clone(),
+            Value::Number(p.entity as i64),
+            names.get(&p.ifc_type),
+            names.text(&p.name),
+        ],
+        origin.clone(),
+    );
+    facts.add(
+        "piece_box",
+        vec![id.clone(), obox_value(&p.obox)],
+        Origin::Entity(p.item),
+    );
+    facts.add(
+        "piece_size",
+        vec![
+            id.clone(),
+            Value::float(p.obox.length()),
+            Value::float(p.obox.width()),
+            Value::float(p.obox.thickness()),
+        ],
+        Origin::Entity(p.item),
+    );
+    facts.add(
+        "piece_index",
+        vec![id.clone(), Value::Number(index as i64)],
+        origin.clone(),
+    );
+    facts.add(
+        "piece_type",
+        vec![
+            id.clone(),
+            names.text(&p.predefined_type),
+            names.text(&p.object_type),
+        ],
+        origin.clone(),
+    );
+    if let Some(group) = p.parent.and_then(|g| model.groups.get(&g)) {
+        facts.add(
+            "piece_group",
+            vec![
+                id.clone(),
+                names.get(&group.global_id),
+                names.get(&group.ifc_type),
+                names.text(&group.name),
+            ],
+            Origin::Entity(group.entity),
+        );
+    }
+    let container = p.container.and_then(|c| model.groups.get(&c));
+    facts.add(
+        "piece_container",
+        vec![
+            id.clone(),
+            names.get(container.map_or("", |c| c.global_id.as_str())),
+        ],
+        container.map_or(origin.clone(), |c| Origin::Entity(c.entity)),
+    );
+    let (density, _) = density_of(p.material.as_deref());
+    facts.add(
+        "piece_material",
+        vec![id.clone(), names.text(&p.material), Value::float(density)],
+        origin,
+    );
+}
+
+/// The two `contact` facts of a touching pair, one from each side.
+fn add_contact_facts(
+    facts: &mut Facts,
+    names: &mut Symbols,
+    model: &Model,
+    ids: &[Value],
+    c: &crate::geom::Contact,
+) {
+    let (a, b) = (&model.pieces()[c.a], &model.pieces()[c.b]);
+    let kind = names.get(c.kind.name());
+    let (face_a, face_b) = (names.get(c.face_a.name()), names.get(c.face_b.name()));
+    facts.add(
+        "contact",
+        vec![
+            ids[c.a].clone(),
+            ids[c.b].clone(),
+            kind.clone(),
+            face_a.clone(),
+            face_b.clone(),
+            Value::float(c.gap),
+            vec3(&c.normal),
+            vec3(&c.centre.coords),
+        ],
+        Origin::Entity(a.entity),
+    );
+    facts.add(
+        "contact",
+        vec![
+            ids[c.b].clone(),
+            ids[c.a].clone(),
+            kind,
+            face_b,
+            face_a,
+            Value::float(c.gap),
+            vec3(&-c.normal),
+            vec3(&c.centre.coords),
+        ],
+        Origin::Entity(b.entity),
+    );
 }
 
 /// One symbol per distinct name: fewer allocations to make and to free.

@@ -89,8 +89,9 @@ impl Default for ContactOptions {
 
 /// All touching pairs, sorted by `(a, b)`.
 pub fn contacts(boxes: &[OrientedBox], options: &ContactOptions) -> Vec<Contact> {
+    use rayon::prelude::*;
     let mut found: Vec<Contact> = candidate_pairs(boxes, options.tolerance)
-        .into_iter()
+        .into_par_iter()
         .filter_map(|(a, b)| touch(boxes, a, b, options))
         .collect();
     found.sort_by_key(|c| (c.a, c.b));
