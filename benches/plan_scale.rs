@@ -29,6 +29,10 @@ use framewright::synth::{Grouping, WriteOptions, models, write_ifc};
 use std::path::Path;
 use std::time::Instant;
 
+// The allocator the command line uses (src/main.rs), so the figures are `plan`'s.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// How `plan` reasons: fused (one pass, the search, the placement slice) or in two passes
 /// with these search options.
 enum Reasoning {

@@ -86,6 +86,9 @@ impl Plan {
     /// Collects the plan from the rule base's relations (missing relations give empty parts).
     pub fn from_reasoned(model: &Model, r: &Reasoned) -> Plan {
         use rayon::prelude::*;
+        // The relations alone (the interpreter `r` may hold is not shared between threads).
+        let relations = &r.relations;
+        let get = |relation: &str| relations.get(relation).map_or(&[][..], Vec::as_slice);
         // Lookups borrow the relations' symbols; only what the plan keeps is copied.
         let index: FxHashMap<&str, usize> = model
             .pieces()
@@ -95,142 +98,149 @@ impl Plan {
             .collect();
         let file_order = |p: &str| index.get(p).copied().unwrap_or(usize::MAX);
         let pairs = |relation: &str| -> Vec<(&str, &str)> {
-            r.get(relation)
+            get(relation)
                 .iter()
                 .map(|t| (sym(&t[0]), sym(&t[1])))
                 .collect()
         };
         let wall_pairs = pairs("wall_of");
         let wall_of_piece: FxHashMap<&str, &str> = wall_pairs.iter().copied().collect();
-        let roles: BTreeMap<String, String> = pairs("role")
-            .into_iter()
-            .map(|(p, role)| (p.to_string(), role.to_string()))
-            .collect();
-        let masses: BTreeMap<String, f64> = r
-            .get("piece_material")
-            .iter()
-            .filter_map(|t| {
-                let p = model.pieces().get(*index.get(sym(&t[0]))?)?;
-                Some((p.id.clone(), p.obox.volume() * float(&t[2])))
-            })
-            .collect();
-        let groups: FxHashMap<&str, (&str, &str)> = r
-            .get("wall_group")
-            .iter()
-            .map(|t| (sym(&t[0]), (sym(&t[1]), sym(&t[3]))))
-            .collect();
-        let frames: FxHashMap<&str, Isometry3<f64>> = r
-            .get("wall_frame")
-            .iter()
-            .map(|t| (sym(&t[0]), iso(&t[1])))
-            .collect();
-        let sizes: FxHashMap<&str, [f64; 3]> = r
-            .get("wall_size")
-            .iter()
-            .map(|t| (sym(&t[0]), [float(&t[1]), float(&t[2]), float(&t[3])]))
-            .collect();
-        let ranks: FxHashMap<&str, i64> = r
-            .get("assembly_rank")
-            .iter()
-            .map(|t| (sym(&t[0]), t[1].as_number().unwrap_or(i64::MAX)))
-            .collect();
-
-        // Walls in file order of their key piece.
-        let mut keys: Vec<&str> = r.get("wall").iter().map(|t| sym(&t[0])).collect();
-        keys.sort_by_key(|k| file_order(k));
-        // Members, precedence, nailing and framing targets bucketed by wall in one pass each.
-        let mut members: FxHashMap<&str, Vec<&str>> = FxHashMap::default();
-        for (p, w) in &wall_of_piece {
-            members.entry(w).or_default().push(p);
-        }
-        let mut precedence_by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
-        for t in r.get("precedence") {
-            if let (Some(w), Some(w2)) =
-                (wall_of_piece.get(sym(&t[0])), wall_of_piece.get(sym(&t[1])))
-                && w == w2
-            {
-                precedence_by.entry(w).or_default().push(t);
-            }
-        }
-        let by_wall_of_first = |relation: &str| {
-            let mut by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
-            for t in r.get(relation) {
-                if let Some(w) = wall_of_piece.get(sym(&t[0])) {
-                    by.entry(w).or_default().push(t);
-                }
-            }
-            by
+        // The per-piece maps and the walls are built side by side.
+        let piece_maps = || {
+            let roles: BTreeMap<String, String> = pairs("role")
+                .into_iter()
+                .map(|(p, role)| (p.to_string(), role.to_string()))
+                .collect();
+            let masses: BTreeMap<String, f64> = get("piece_material")
+                .iter()
+                .filter_map(|t| {
+                    let p = model.pieces().get(*index.get(sym(&t[0]))?)?;
+                    Some((p.id.clone(), p.obox.volume() * float(&t[2])))
+                })
+                .collect();
+            (roles, masses)
         };
-        let nails_by = by_wall_of_first("nailing_target");
-        let framing_by = by_wall_of_first("framing_target");
-        let walls: Vec<Wall> = keys
-            .par_iter()
-            .enumerate()
-            .map(|(n, &key)| {
-                let mut list = members.get(key).cloned().unwrap_or_default();
-                list.sort_by_key(|p| (file_order(p), *p));
-                let mut order = list.clone();
-                order.sort_by_key(|p| (ranks.get(p).copied().unwrap_or(i64::MAX), file_order(p)));
-                let mut precedence: Vec<(String, String, String)> = precedence_by
-                    .get(key)
-                    .into_iter()
-                    .flatten()
-                    .map(|t| (owned(&t[0]), owned(&t[1]), owned(&t[2])))
-                    .collect();
-                precedence.sort();
-                let mut nailing_targets: Vec<NailingTarget> = nails_by
-                    .get(key)
-                    .into_iter()
-                    .flatten()
-                    .map(|t| NailingTarget {
-                        plate: owned(&t[0]),
-                        member: owned(&t[1]),
-                        kind: owned(&t[2]),
-                        u: float(&t[3]),
-                        v: float(&t[4]),
-                        w: float(&t[5]),
-                        world: Point3::from(vec3(&t[6])),
-                        direction: vec3(&t[7]),
-                    })
-                    .collect();
-                nailing_targets.sort_by(|a, b| {
-                    (a.u, a.v, a.w)
-                        .partial_cmp(&(b.u, b.v, b.w))
-                        .unwrap_or(std::cmp::Ordering::Equal)
-                });
-                let position: FxHashMap<&str, usize> =
-                    order.iter().enumerate().map(|(i, p)| (*p, i)).collect();
-                let mut framing: Vec<(&str, Isometry3<f64>)> = framing_by
-                    .get(key)
-                    .into_iter()
-                    .flatten()
-                    .map(|t| (sym(&t[0]), iso(&t[1])))
-                    .collect();
-                framing.sort_by_key(|(p, _)| position.get(p).copied());
-                let group = groups.get(key);
-                let size = sizes.get(key).copied().unwrap_or([f64::NAN; 3]);
-                let strings = |v: Vec<&str>| v.into_iter().map(str::to_string).collect();
-                Wall {
-                    id: group.map_or_else(|| format!("W{}", n + 1), |(g, _)| g.to_string()),
-                    name: group
-                        .map_or_else(|| format!("Wall {}", n + 1), |(_, name)| name.to_string()),
-                    key: key.to_string(),
-                    group_global_id: group.map(|(g, _)| g.to_string()),
-                    members: strings(list),
-                    frame: frames.get(key).copied().unwrap_or_else(Isometry3::identity),
-                    length: size[0],
-                    height: size[1],
-                    thickness: size[2],
-                    assembly_order: strings(order),
-                    precedence,
-                    nailing_targets,
-                    framing_targets: framing
-                        .into_iter()
-                        .map(|(p, pose)| (p.to_string(), pose))
-                        .collect(),
+        let build_walls = || {
+            let groups: FxHashMap<&str, (&str, &str)> = get("wall_group")
+                .iter()
+                .map(|t| (sym(&t[0]), (sym(&t[1]), sym(&t[3]))))
+                .collect();
+            let frames: FxHashMap<&str, Isometry3<f64>> = get("wall_frame")
+                .iter()
+                .map(|t| (sym(&t[0]), iso(&t[1])))
+                .collect();
+            let sizes: FxHashMap<&str, [f64; 3]> = get("wall_size")
+                .iter()
+                .map(|t| (sym(&t[0]), [float(&t[1]), float(&t[2]), float(&t[3])]))
+                .collect();
+            let ranks: FxHashMap<&str, i64> = get("assembly_rank")
+                .iter()
+                .map(|t| (sym(&t[0]), t[1].as_number().unwrap_or(i64::MAX)))
+                .collect();
+
+            // Walls in file order of their key piece.
+            let mut keys: Vec<&str> = get("wall").iter().map(|t| sym(&t[0])).collect();
+            keys.sort_by_key(|k| file_order(k));
+            // Members, precedence, nailing and framing targets bucketed by wall in one pass each.
+            let mut members: FxHashMap<&str, Vec<&str>> = FxHashMap::default();
+            for (p, w) in &wall_of_piece {
+                members.entry(w).or_default().push(p);
+            }
+            let mut precedence_by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
+            for t in get("precedence") {
+                if let (Some(w), Some(w2)) =
+                    (wall_of_piece.get(sym(&t[0])), wall_of_piece.get(sym(&t[1])))
+                    && w == w2
+                {
+                    precedence_by.entry(w).or_default().push(t);
                 }
-            })
-            .collect();
+            }
+            let by_wall_of_first = |relation: &str| {
+                let mut by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
+                for t in get(relation) {
+                    if let Some(w) = wall_of_piece.get(sym(&t[0])) {
+                        by.entry(w).or_default().push(t);
+                    }
+                }
+                by
+            };
+            let nails_by = by_wall_of_first("nailing_target");
+            let framing_by = by_wall_of_first("framing_target");
+            let walls: Vec<Wall> = keys
+                .par_iter()
+                .enumerate()
+                .map(|(n, &key)| {
+                    let mut list = members.get(key).cloned().unwrap_or_default();
+                    list.sort_by_key(|p| (file_order(p), *p));
+                    let mut order = list.clone();
+                    order.sort_by_key(|p| {
+                        (ranks.get(p).copied().unwrap_or(i64::MAX), file_order(p))
+                    });
+                    let mut precedence: Vec<(String, String, String)> = precedence_by
+                        .get(key)
+                        .into_iter()
+                        .flatten()
+                        .map(|t| (owned(&t[0]), owned(&t[1]), owned(&t[2])))
+                        .collect();
+                    precedence.sort();
+                    let mut nailing_targets: Vec<NailingTarget> = nails_by
+                        .get(key)
+                        .into_iter()
+                        .flatten()
+                        .map(|t| NailingTarget {
+                            plate: owned(&t[0]),
+                            member: owned(&t[1]),
+                            kind: owned(&t[2]),
+                            u: float(&t[3]),
+                            v: float(&t[4]),
+                            w: float(&t[5]),
+                            world: Point3::from(vec3(&t[6])),
+                            direction: vec3(&t[7]),
+                        })
+                        .collect();
+                    nailing_targets.sort_by(|a, b| {
+                        (a.u, a.v, a.w)
+                            .partial_cmp(&(b.u, b.v, b.w))
+                            .unwrap_or(std::cmp::Ordering::Equal)
+                    });
+                    let position: FxHashMap<&str, usize> =
+                        order.iter().enumerate().map(|(i, p)| (*p, i)).collect();
+                    let mut framing: Vec<(&str, Isometry3<f64>)> = framing_by
+                        .get(key)
+                        .into_iter()
+                        .flatten()
+                        .map(|t| (sym(&t[0]), iso(&t[1])))
+                        .collect();
+                    framing.sort_by_key(|(p, _)| position.get(p).copied());
+                    let group = groups.get(key);
+                    let size = sizes.get(key).copied().unwrap_or([f64::NAN; 3]);
+                    let strings = |v: Vec<&str>| v.into_iter().map(str::to_string).collect();
+                    Wall {
+                        id: group.map_or_else(|| format!("W{}", n + 1), |(g, _)| g.to_string()),
+                        name: group.map_or_else(
+                            || format!("Wall {}", n + 1),
+                            |(_, name)| name.to_string(),
+                        ),
+                        key: key.to_string(),
+                        group_global_id: group.map(|(g, _)| g.to_string()),
+                        members: strings(list),
+                        frame: frames.get(key).copied().unwrap_or_else(Isometry3::identity),
+                        length: size[0],
+                        height: size[1],
+                        thickness: size[2],
+                        assembly_order: strings(order),
+                        precedence,
+                        nailing_targets,
+                        framing_targets: framing
+                            .into_iter()
+                            .map(|(p, pose)| (p.to_string(), pose))
+                            .collect(),
+                    }
+                })
+                .collect();
+            walls
+        };
+        let ((roles, masses), walls) = rayon::join(piece_maps, build_walls);
         let wall_ids: FxHashMap<&str, &str> = walls
             .iter()
             .map(|w| (w.key.as_str(), w.id.as_str()))
