@@ -7,9 +7,10 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 // The rule tables make and free millions of small tuples, from several threads at once;
-// mimalloc does that with less work than the system allocator. It is built without
-// transparent huge pages (feature `no_thp`): faulting those in cost `plan` on a
-// 49,410-member model 0.2-0.5 s more system time, varying from run to run.
+// mimalloc does that with less work than the system allocator. It is built without asking
+// for transparent huge pages (feature `no_thp`: no madvise): faulting those in cost `plan`
+// on a 49,410-member model 0.2-0.5 s more system time, varying from run to run, on a host
+// whose THP setting is `madvise` (one set to `always` still gives them).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

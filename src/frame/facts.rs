@@ -197,13 +197,14 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
     use rayon::prelude::*;
     let pieces = model.pieces();
     let ids: Vec<Value> = pieces.par_iter().map(|p| sym(&p.id)).collect();
-    let per_run = |n: usize| n.div_ceil(rayon::current_num_threads() * 8).max(256);
+    // A fixed run size: how symbols are shared must not follow the machine's threads.
+    const PER_RUN: usize = 1024;
     let piece_runs: Vec<Facts> = pieces
-        .par_chunks(per_run(pieces.len()))
-        .zip(ids.par_chunks(per_run(pieces.len())))
+        .par_chunks(PER_RUN)
+        .zip(ids.par_chunks(PER_RUN))
         .enumerate()
         .map(|(run, (pieces_of_run, ids_of_run))| {
-            let first = run * per_run(pieces.len());
+            let first = run * PER_RUN;
             let mut facts = Facts::default();
             // Names that repeat (types, materials, containers) share one symbol.
             let mut names = Symbols::default();
@@ -216,7 +217,7 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
     let boxes: Vec<OrientedBox> = pieces.iter().map(|p| p.obox).collect();
     let found = contacts(&boxes, contact_options);
     let contact_runs: Vec<Facts> = found
-        .par_chunks(per_run(found.len()))
+        .par_chunks(PER_RUN)
         .map(|run| {
             let mut facts = Facts::default();
             let mut names = Symbols::default();

@@ -78,6 +78,9 @@ pub(crate) struct Read {
     pub warnings: Vec<Warning>,
 }
 
+/// Products read by one parallel run.
+const PRODUCTS_PER_RUN: usize = 512;
+
 /// The pieces and warnings of one run of products.
 type Run = (Vec<Piece>, Vec<Warning>);
 
@@ -106,13 +109,11 @@ pub(crate) fn read(mut ctx: Ctx<'_>) -> Result<Read, IfcErrorKind> {
 
     // Products are read in parallel runs, each with its own placement cache and warnings;
     // the runs are joined in file order, and the first fatal issue in file order stops the
-    // read, as one pass would.
-    let chunk = records
-        .len()
-        .div_ceil(rayon::current_num_threads() * 8)
-        .max(64);
+    // read, as one pass would. Runs have a fixed size, not one that follows the machine's
+    // threads: where a run's cache starts matters to a placement chain longer than
+    // MAX_CHAIN, and the answer must not depend on the machine.
     let runs: Vec<Result<Run, IfcErrorKind>> = records
-        .par_chunks(chunk)
+        .par_chunks(PRODUCTS_PER_RUN)
         .map(|run| {
             let ctx = Ctx::new(ctx.file, ctx.schema, ctx.scale);
             let mut placements = Placements::default();
