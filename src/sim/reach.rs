@@ -65,17 +65,36 @@ pub fn continuous_line(
     tcp: &Isometry3<f64>,
     samples: usize,
 ) -> Result<(Vec<f64>, Vec<f64>), IkFailure> {
+    continuous_line_where(cell, seed, (from, to), tcp, samples, |_, _| None)
+}
+
+/// `continuous_line` whose branch must also pass `refuse` (given the joints at `from` and at
+/// `to`; `Some(why)` refuses the branch). When none passes, the first refusal is the miss
+/// (that branch got there), else the first branch's failure along the line.
+pub fn continuous_line_where(
+    cell: &Cell,
+    seed: &[f64],
+    (from, to): (&Isometry3<f64>, &Isometry3<f64>),
+    tcp: &Isometry3<f64>,
+    samples: usize,
+    mut refuse: impl FnMut(&[f64], &[f64]) -> Option<IkFailure>,
+) -> Result<(Vec<f64>, Vec<f64>), IkFailure> {
     let starts = cell.robot.ik(&cell.to_robot(from), tcp, seed)?;
-    let mut first_failure = None;
+    let (mut refused, mut first_failure) = (None, None);
     for start in starts {
         match line(cell, &start, from, to, tcp, samples) {
-            Ok(end) => return Ok((start, end)),
+            Ok(end) => match refuse(&start, &end) {
+                None => return Ok((start, end)),
+                Some(why) => {
+                    refused.get_or_insert(why);
+                }
+            },
             Err(f) => {
                 first_failure.get_or_insert(f);
             }
         }
     }
-    Err(first_failure.unwrap_or(IkFailure::InvalidPose))
+    Err(refused.or(first_failure).unwrap_or(IkFailure::InvalidPose))
 }
 
 /// Err(BranchJump) when a joint moves more than MAX_BRANCH_STEP between two line samples,

@@ -7,7 +7,7 @@ use crate::cell::IkFailure;
 use crate::cell::tcp_poses::{nail_lines, nail_pose, nail_rolls, retreat};
 use crate::frame::plan::NailingTarget;
 use crate::sim::motion::LinearMove;
-use crate::sim::reach::{line, touches};
+use crate::sim::reach::{continuous_line_where, touches};
 use crate::sim::record::{NailOutcome, NailRecord, failure_columns};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
@@ -274,25 +274,13 @@ impl<'a> WallRun<'a> {
         tcp: &Isometry3<f64>,
     ) -> Result<Vec<f64>, IkFailure> {
         let ignore = [nail.plate.as_str(), nail.member.as_str()];
-        let mut first: Option<IkFailure> = None;
-        let mut collision: Option<IkFailure> = None;
-        for qa in at.robot.ik(&at.to_robot(back), tcp, &self.q)? {
-            match line(at, &qa, back, fire, tcp, 4) {
-                Ok(q_fire) => match touches(&self.phys, at, &q_fire, None, &ignore, 0.0)
-                    .or_else(|| touches(&self.phys, at, &qa, None, &[], 0.0))
-                {
-                    None => return Ok(qa),
-                    Some((a, b)) => {
-                        collision.get_or_insert(IkFailure::AllSolutionsCollide { pair: [a, b] });
-                    }
-                },
-                Err(f) => {
-                    first.get_or_insert(f);
-                }
-            }
-        }
         // A solution that got there but collides is the more telling miss.
-        Err(collision.or(first).unwrap_or(IkFailure::InvalidPose))
+        let collides = |q_back: &[f64], q_fire: &[f64]| {
+            touches(&self.phys, at, q_fire, None, &ignore, 0.0)
+                .or_else(|| touches(&self.phys, at, q_back, None, &[], 0.0))
+                .map(|(a, b)| IkFailure::AllSolutionsCollide { pair: [a, b] })
+        };
+        continuous_line_where(at, &self.q, (back, fire), tcp, 4, collides).map(|(q_back, _)| q_back)
     }
 
     /// Whether a nail entering at `point` along `line` (cell frame) runs through its plate into
