@@ -4,6 +4,7 @@
 use crate::geom::{ContactOptions, OrientedBox, contacts};
 use crate::ifc::Model;
 use crate::logic::compiled::Relations;
+use crate::logic::value::Sym;
 use crate::logic::{Engine, LogicError, OBox, Origin, Value, Vec3};
 use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
@@ -108,13 +109,14 @@ impl Facts {
 }
 
 /// `Facts::by_container` on tuples without origins.
-fn split_by_container(mut tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Vec<Relations> {
-    let mut part_names: FxHashMap<&str, usize> = FxHashMap::default();
-    let mut part_of_piece: FxHashMap<&str, usize> = FxHashMap::default();
+fn split_by_container(tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Vec<Relations> {
+    // Keyed by shared symbols (not borrowed names), so the tuples can be moved below.
+    let mut part_names: FxHashMap<Sym, usize> = FxHashMap::default();
+    let mut part_of_piece: FxHashMap<Sym, usize> = FxHashMap::default();
     for t in tuples.get("piece_container").into_iter().flatten() {
-        if let (Some(p), Some(c)) = (t[0].as_symbol(), t[1].as_symbol()) {
+        if let (Value::Symbol(p), Value::Symbol(c)) = (&t[0], &t[1]) {
             let next = part_names.len();
-            part_of_piece.insert(p, *part_names.entry(c).or_insert(next));
+            part_of_piece.insert(p.clone(), *part_names.entry(c.clone()).or_insert(next));
         }
     }
     let n = part_names.len().max(1);
@@ -122,35 +124,18 @@ fn split_by_container(mut tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Ve
         v.and_then(Value::as_symbol)
             .and_then(|p| part_of_piece.get(p).copied())
     };
-    // Where each tuple goes, decided while the piece names are borrowed.
-    let destinations: Vec<(&'static str, Vec<Destination>)> = tuples
-        .iter()
-        .map(|(name, tuples)| {
-            let to = tuples
-                .iter()
-                .map(|tuple| match part_of(tuple.first()) {
-                    Some(k) if *name == "contact" => {
-                        if part_of(tuple.get(1)) == Some(k) {
-                            Destination::Part(k)
-                        } else {
-                            Destination::Nowhere
-                        }
-                    }
-                    Some(k) => Destination::Part(k),
-                    None => Destination::Every,
-                })
-                .collect();
-            (*name, to)
-        })
-        .collect();
     let mut parts: Vec<Relations> = vec![Relations::new(); n];
-    for (name, to) in destinations {
+    for (name, relation) in tuples {
         let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); n];
-        for (tuple, to) in tuples.remove(name).unwrap_or_default().into_iter().zip(to) {
-            match to {
-                Destination::Part(k) => buckets[k].push(tuple),
-                Destination::Every => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
-                Destination::Nowhere => {}
+        for tuple in relation {
+            match part_of(tuple.first()) {
+                Some(k) if name == "contact" => {
+                    if part_of(tuple.get(1)) == Some(k) {
+                        buckets[k].push(tuple);
+                    }
+                }
+                Some(k) => buckets[k].push(tuple),
+                None => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
             }
         }
         for (part, bucket) in parts.iter_mut().zip(buckets) {
@@ -158,14 +143,6 @@ fn split_by_container(mut tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Ve
         }
     }
     parts
-}
-
-/// The part a fact goes to in `split_by_container`.
-#[derive(Clone, Copy)]
-enum Destination {
-    Part(usize),
-    Every,
-    Nowhere,
 }
 
 fn sym(s: &str) -> Value {
