@@ -116,13 +116,13 @@ fn split_by_container(tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Vec<Re
     for t in tuples.get("piece_container").into_iter().flatten() {
         if let (Value::Symbol(p), Value::Symbol(c)) = (&t[0], &t[1]) {
             let next = part_names.len();
-            part_of_piece.insert(p.clone(), *part_names.entry(c.clone()).or_insert(next));
+            part_of_piece.insert(*p, *part_names.entry(*c).or_insert(next));
         }
     }
     let n = part_names.len().max(1);
-    let part_of = |v: Option<&Value>| {
-        v.and_then(Value::as_symbol)
-            .and_then(|p| part_of_piece.get(p).copied())
+    let part_of = |v: Option<&Value>| match v {
+        Some(Value::Symbol(p)) => part_of_piece.get(p).copied(),
+        _ => None,
     };
     let mut parts: Vec<Relations> = vec![Relations::new(); n];
     for (name, relation) in tuples {

@@ -5,7 +5,7 @@
 use super::value::{F64, Sym, format_float};
 use std::cell::RefCell;
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Mutex, OnceLock};
 
 pub type OpResult<T> = Result<T, String>;
 
@@ -72,7 +72,7 @@ pub fn cat_bounded(parts: &[&str]) -> OpResult<Sym> {
     Ok(cat(parts))
 }
 pub fn cat(parts: &[&str]) -> Sym {
-    Arc::from(parts.concat().as_str())
+    Sym::from(parts.concat().as_str())
 }
 /// Length in bytes, as Soufflé's `strlen`.
 pub fn strlen(s: &str) -> i64 {
@@ -88,7 +88,7 @@ pub fn substr(s: &str, start: i64, len: i64) -> OpResult<Sym> {
     }
     let end = (start as usize).saturating_add(len as usize).min(s.len());
     s.get(start as usize..end)
-        .map(Arc::from)
+        .map(Sym::from)
         .ok_or_else(|| format!("substr({s:?}, {start}, {len}) would split a UTF-8 character"))
 }
 /// Ordinals handed out by `ord`, in order of first use.
@@ -150,13 +150,13 @@ pub fn to_float(s: &str) -> OpResult<F64> {
         .map_err(|_| format!("to_float({s:?}): not a float"))
 }
 pub fn i64_to_string(n: i64) -> Sym {
-    Arc::from(n.to_string().as_str())
+    Sym::from(n.to_string().as_str())
 }
 pub fn u64_to_string(n: u64) -> Sym {
-    Arc::from(n.to_string().as_str())
+    Sym::from(n.to_string().as_str())
 }
 pub fn f64_to_string(x: F64) -> Sym {
-    Arc::from(format_float(x.0).as_str())
+    Sym::from(format_float(x.0).as_str())
 }
 pub fn contains(needle: &str, hay: &str) -> bool {
     hay.contains(needle)

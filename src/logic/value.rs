@@ -16,8 +16,11 @@ use std::sync::Arc;
 
 pub use super::front::ast::BaseTy;
 
-/// A symbol: shared immutable text, compared and ordered by content.
-pub type Sym = Arc<str>;
+/// A symbol: interned immutable text. Equal symbols share one address, so equality is a
+/// pointer comparison and hashing reads a hash of the text computed once (the same on every
+/// machine, so hash-ordered work stays deterministic); order is by content. Interned text is
+/// never freed: a run holds the names of the models it reads.
+pub type Sym = ustr_fxhash::Ustr;
 
 /// A float column value with a total order and bitwise hash.
 #[derive(Clone, Copy, Debug, Default)]
@@ -155,7 +158,7 @@ impl OBox {
 float_tuple_traits!(OBox);
 
 /// One value of a tuple. Geometry is behind `Arc` to keep the enum small.
-#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Value {
     Number(i64),
     Unsigned(u64),
@@ -166,9 +169,24 @@ pub enum Value {
     Box(Arc<OBox>),
 }
 
+/// As derived, with a symbol shown as its text (`Symbol("a")`).
+impl fmt::Debug for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Number(n) => f.debug_tuple("Number").field(n).finish(),
+            Value::Unsigned(n) => f.debug_tuple("Unsigned").field(n).finish(),
+            Value::Float(x) => f.debug_tuple("Float").field(x).finish(),
+            Value::Symbol(s) => f.debug_tuple("Symbol").field(&s.as_str()).finish(),
+            Value::Vec3(v) => f.debug_tuple("Vec3").field(v).finish(),
+            Value::Iso(i) => f.debug_tuple("Iso").field(i).finish(),
+            Value::Box(b) => f.debug_tuple("Box").field(b).finish(),
+        }
+    }
+}
+
 impl Value {
     pub fn sym(s: &str) -> Value {
-        Value::Symbol(Arc::from(s))
+        Value::Symbol(Sym::from(s))
     }
     pub fn float(x: f64) -> Value {
         Value::Float(F64(x))
@@ -402,7 +420,7 @@ macro_rules! column {
 column!(i64, Number, Number, |x| *x, |y| y);
 column!(u64, Unsigned, Unsigned, |x| *x, |y| y);
 column!(F64, Float, Float, |x| *x, |y| y);
-column!(Sym, Symbol, Symbol, |x| x.clone(), |y| y);
+column!(Sym, Symbol, Symbol, |x| *x, |y| y);
 column!(Vec3, Vec3, Vec3, |x| *x, |y| y);
 column!(Iso, Iso, Iso, |x| **x, |y| Arc::new(y));
 column!(OBox, Box, Box, |x| **x, |y| Arc::new(y));

@@ -5,7 +5,6 @@
 use crate::logic::ops;
 use crate::logic::value::{F64, Sym};
 use std::cell::RefCell;
-use std::sync::Arc;
 
 thread_local! {
     static ERROR: RefCell<Option<String>> = const { RefCell::new(None) };
@@ -38,7 +37,7 @@ fn or_fail<T>(r: ops::OpResult<T>, rule: &str, fallback: T) -> T {
 }
 
 pub fn sym(s: &str) -> Sym {
-    Arc::from(s)
+    Sym::from(s)
 }
 pub fn div_i64(a: i64, b: i64, rule: &str) -> i64 {
     or_fail(ops::div_i64(a, b), rule, 0)
