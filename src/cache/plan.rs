@@ -178,15 +178,17 @@ fn first_run(
     let everything: Vec<usize> = (0..partition.parts.len()).collect();
     let shares = shares(partition, &everything, &reasoned.relations);
     let wall_slot = reasoned.relations.keys().position(|n| n == "wall");
-    let walls: Vec<usize> = shares
+    // Encoded here, written on a thread of their own while the caller builds its plan.
+    let (walls, entries): (Vec<usize>, Vec<(String, Vec<u8>)>) = shares
         .par_iter()
         .enumerate()
         .map(|(i, share)| {
             let bytes = encode_share(&keys[i], &reasoned.relations, share);
-            cache.put_plan(&keys[i], &bytes);
-            share.iter().filter(|(r, _)| Some(*r) == wall_slot).count()
+            let walls = share.iter().filter(|(r, _)| Some(*r) == wall_slot).count();
+            (walls, (keys[i].clone(), bytes))
         })
-        .collect();
+        .unzip();
+    cache.put_plans_behind(entries);
     counts.rejected = (0..walls.len())
         .filter(|&i| rejected[i])
         .map(|i| walls[i])

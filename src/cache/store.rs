@@ -9,8 +9,9 @@ use crate::sim::WallRecord;
 use crate::sim::record::PoseTrace;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
 
 /// Subfolder of wall simulation entries.
 const WALLS: &str = "walls";
@@ -21,6 +22,14 @@ const WHY_PREFIX: &str = "sim-";
 
 /// A cache folder in use.
 pub struct Cache {
+    shared: Arc<Folder>,
+    /// Entries being written behind the caller's back (`put_plans_behind`); joined by the
+    /// next lookup of plan entries, by `take_warning` and on drop.
+    behind: Mutex<Vec<JoinHandle<()>>>,
+}
+
+/// What the writers of a cache folder share.
+struct Folder {
     dir: PathBuf,
     write_failed: AtomicBool,
     warning: Mutex<Option<String>>,
@@ -37,41 +46,65 @@ pub enum Lookup {
 impl Cache {
     pub fn new(dir: impl Into<PathBuf>) -> Cache {
         Cache {
-            dir: dir.into(),
-            write_failed: AtomicBool::new(false),
-            warning: Mutex::new(None),
+            shared: Arc::new(Folder {
+                dir: dir.into(),
+                write_failed: AtomicBool::new(false),
+                warning: Mutex::new(None),
+            }),
+            behind: Mutex::new(Vec::new()),
         }
     }
 
     pub fn dir(&self) -> &Path {
-        &self.dir
-    }
-
-    /// `DIR/<folder>/<first two characters of key>/<key>.<extension>`: the two-character
-    /// fan-out keeps folders small on shared filesystems.
-    fn entry_path(&self, folder: &str, key: &str, extension: &str) -> PathBuf {
-        self.dir
-            .join(folder)
-            .join(&key[..2.min(key.len())])
-            .join(format!("{key}.{extension}"))
+        &self.shared.dir
     }
 
     fn wall_path(&self, key: &str) -> PathBuf {
-        self.entry_path(WALLS, key, "json")
+        self.shared.entry_path(WALLS, key, "json")
     }
 
-    fn plan_path(&self, key: &str) -> PathBuf {
-        self.entry_path(PLANS, key, "part")
-    }
-
-    /// The bytes of a plan part's entry (the caller verifies them), None when absent.
+    /// The bytes of a plan part's entry (the caller verifies them), None when absent. Waits
+    /// for this cache's entries still being written, so a lookup sees every entry stored
+    /// before it.
     pub fn get_plan(&self, key: &str) -> Option<Vec<u8>> {
-        std::fs::read(self.plan_path(key)).ok()
+        self.wait_for_writes();
+        std::fs::read(self.shared.plan_path(key)).ok()
     }
 
     /// Stores a plan part's entry, like `put_wall`.
     pub fn put_plan(&self, key: &str, bytes: &[u8]) {
-        self.put(&self.plan_path(key), |w| w.write_all(bytes));
+        self.shared
+            .put(&self.shared.plan_path(key), |w| w.write_all(bytes));
+    }
+
+    /// Stores plan part entries (key, bytes) on a thread of their own, so the caller goes on
+    /// while the files are written; each is written like `put_plan`. The next lookup, the
+    /// write warning and dropping the cache wait for them.
+    pub fn put_plans_behind(&self, entries: Vec<(String, Vec<u8>)>) {
+        let entries = Arc::new(entries);
+        let (folder, job) = (Arc::clone(&self.shared), Arc::clone(&entries));
+        match std::thread::Builder::new()
+            .name("framewright cache writer".into())
+            .spawn(move || folder.put_plans(&job))
+        {
+            Ok(handle) => self.pending().push(handle),
+            // No thread to spare: write them now.
+            Err(_) => self.shared.put_plans(&entries),
+        }
+    }
+
+    fn pending(&self) -> std::sync::MutexGuard<'_, Vec<JoinHandle<()>>> {
+        // A writer that panicked left no half entry (entries are renamed into place whole);
+        // its handles are still there to join.
+        self.behind.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Waits until the entries written behind are on disk (or failed, with a warning).
+    pub fn wait_for_writes(&self) {
+        let handles = std::mem::take(&mut *self.pending());
+        for h in handles {
+            let _ = h.join();
+        }
     }
 
     /// A wall's pose trace sits beside its record, under the same key.
@@ -100,7 +133,7 @@ impl Cache {
 
     /// Stores a wall's record; a failure turns writing off for this run and leaves a warning.
     pub fn put_wall(&self, key: &str, record: &WallRecord) {
-        self.put(&self.wall_path(key), |w| {
+        self.shared.put(&self.wall_path(key), |w| {
             serde_json::to_writer(w, &Entry::new(key, record)).map_err(std::io::Error::other)
         });
     }
@@ -108,10 +141,45 @@ impl Cache {
     /// Stores a wall's pose trace (for the report's animation), like `put_wall`.
     pub fn put_trace(&self, key: &str, trace: &PoseTrace) {
         if let Some(bytes) = trace_codec::encode(key, trace) {
-            self.put(&self.trace_path(key), |w| w.write_all(&bytes));
+            self.shared
+                .put(&self.trace_path(key), |w| w.write_all(&bytes));
         }
     }
 
+    /// The warning of a failed write, once (after the writes behind are done).
+    pub fn take_warning(&self) -> Option<String> {
+        self.wait_for_writes();
+        self.shared.warning.lock().ok().and_then(|mut w| w.take())
+    }
+}
+
+impl Drop for Cache {
+    fn drop(&mut self) {
+        self.wait_for_writes();
+    }
+}
+
+impl Folder {
+    /// `DIR/<folder>/<first two characters of key>/<key>.<extension>`: the two-character
+    /// fan-out keeps folders small on shared filesystems.
+    fn entry_path(&self, folder: &str, key: &str, extension: &str) -> PathBuf {
+        self.dir
+            .join(folder)
+            .join(&key[..2.min(key.len())])
+            .join(format!("{key}.{extension}"))
+    }
+
+    fn plan_path(&self, key: &str) -> PathBuf {
+        self.entry_path(PLANS, key, "part")
+    }
+
+    fn put_plans(&self, entries: &[(String, Vec<u8>)]) {
+        for (key, bytes) in entries {
+            self.put(&self.plan_path(key), |w| w.write_all(bytes));
+        }
+    }
+
+    /// Writes one entry; a failure turns writing off for this run and leaves a warning.
     fn put(&self, path: &Path, write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>) {
         if self.write_failed.load(Ordering::Relaxed) {
             return;
@@ -126,11 +194,6 @@ impl Cache {
                 self.dir.display()
             ));
         }
-    }
-
-    /// The warning of a failed write, once.
-    pub fn take_warning(&self) -> Option<String> {
-        self.warning.lock().ok().and_then(|mut w| w.take())
     }
 }
 

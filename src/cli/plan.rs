@@ -49,7 +49,6 @@ pub fn run(args: PlanArgs) -> CmdResult {
             )
         }
     };
-    warn_if_unwritable(cache.as_ref());
     let plan = Plan::from_reasoned(&model, &reasoned);
     let mut report = PlanReport::new(&model, &plan);
     report.cache = counts;
@@ -59,5 +58,7 @@ pub fn run(args: PlanArgs) -> CmdResult {
         print_stdout(&report.to_text())
     };
     leave_to_exit((model, reasoned, plan, report));
+    // After the output: the cache's entries are written meanwhile.
+    warn_if_unwritable(cache.as_ref());
     written
 }
