@@ -19,7 +19,7 @@ use crate::frame::plan::Plan;
 use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, RuleLimits};
 use crate::logic::compiled::{Relations, builtin};
 use crate::logic::functors::defs::{box_centre, box_radius, dot};
-use crate::logic::value::{F64, OBox, Value, Vec3};
+use crate::logic::value::{F64, OBox, Sym, Value, Vec3};
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::Mutex;
@@ -321,30 +321,32 @@ fn reason_part(
 /// tuple naming none (what the cell alone gives) to every part. References, not copies: a
 /// whole model's relations are split without holding them twice.
 fn shares(partition: &Partition, parts: &[usize], out: &Relations) -> Vec<Vec<(usize, usize)>> {
-    let mut owner: FxHashMap<&str, usize> = FxHashMap::default();
-    let mut of_container: FxHashMap<&str, Vec<usize>> = FxHashMap::default();
+    // Keyed by interned symbols: every value of every tuple is looked up.
+    let mut owner: FxHashMap<Sym, usize> = FxHashMap::default();
+    let mut of_container: FxHashMap<Sym, Vec<usize>> = FxHashMap::default();
     for (k, &i) in parts.iter().enumerate() {
         let part = &partition.parts[i];
         for id in part.pieces.iter().chain(&part.groups) {
-            owner.insert(id.as_str(), k);
+            owner.insert(Sym::from(id.as_str()), k);
         }
-        let container = partition.containers[part.container].name.as_str();
+        let container = Sym::from(partition.containers[part.container].name.as_str());
         of_container.entry(container).or_default().push(k);
     }
+    let symbol = |v: &Value| match v {
+        Value::Symbol(s) => Some(*s),
+        _ => None,
+    };
     let everyone: Vec<usize> = (0..parts.len()).collect();
     let mut shares: Vec<Vec<(usize, usize)>> = vec![Vec::new(); parts.len()];
     for (slot, (name, rows)) in out.iter().enumerate() {
         for (row, t) in rows.iter().enumerate() {
             let to: &[usize] = if name == REACH {
                 t.first()
-                    .and_then(Value::as_symbol)
-                    .and_then(|c| of_container.get(c))
+                    .and_then(symbol)
+                    .and_then(|c| of_container.get(&c))
                     .map_or(&[], Vec::as_slice)
             } else {
-                match t
-                    .iter()
-                    .find_map(|v| v.as_symbol().and_then(|s| owner.get(s)))
-                {
+                match t.iter().find_map(|v| symbol(v).and_then(|s| owner.get(&s))) {
                     Some(k) => std::slice::from_ref(k),
                     None => &everyone,
                 }

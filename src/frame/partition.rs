@@ -13,6 +13,7 @@
 
 use super::Facts;
 use crate::logic::compiled::Relations;
+use crate::logic::value::Sym;
 use crate::logic::{OBox, Value};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -58,10 +59,11 @@ impl Partition {
         let mut containers: Vec<Container> = Vec::new();
         let mut container_index: FxHashMap<&str, usize> = FxHashMap::default();
         let mut pieces: Vec<String> = Vec::new();
-        let mut piece_index: FxHashMap<&str, usize> = FxHashMap::default();
+        // Keyed by interned symbols: every tuple below looks its piece up.
+        let mut piece_index: FxHashMap<Sym, usize> = FxHashMap::default();
         let mut container_of: Vec<usize> = Vec::new();
         for (t, _) in facts.tuples.get("piece_container").into_iter().flatten() {
-            let (Some(p), Some(c)) = (t[0].as_symbol(), t[1].as_symbol()) else {
+            let (Value::Symbol(p), Some(c)) = (&t[0], t[1].as_symbol()) else {
                 continue;
             };
             if piece_index.contains_key(p) {
@@ -75,16 +77,16 @@ impl Partition {
                     pieces: Vec::new(),
                 });
             }
-            piece_index.insert(p, pieces.len());
+            piece_index.insert(*p, pieces.len());
             containers[k].pieces.push(pieces.len());
             container_of.push(k);
             pieces.push(p.to_string());
         }
 
         let mut sets = UnionFind::new(pieces.len());
-        let find = |v: Option<&Value>| {
-            v.and_then(Value::as_symbol)
-                .and_then(|p| piece_index.get(p).copied())
+        let find = |v: Option<&Value>| match v {
+            Some(Value::Symbol(p)) => piece_index.get(p).copied(),
+            _ => None,
         };
         let mut across: Vec<Vec<Vector3<f64>>> = vec![Vec::new(); pieces.len()];
         for (t, _) in facts.tuples.get("piece_box").into_iter().flatten() {
