@@ -99,10 +99,11 @@ impl Cache {
         self.behind.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Waits until the entries written behind are on disk (or failed, with a warning).
+    /// Waits until the entries written behind are on disk (or failed, with a warning). The
+    /// list stays locked while they are joined, so a lookup on another thread waits too.
     pub fn wait_for_writes(&self) {
-        let handles = std::mem::take(&mut *self.pending());
-        for h in handles {
+        let mut pending = self.pending();
+        for h in pending.drain(..) {
             let _ = h.join();
         }
     }
