@@ -17,10 +17,65 @@ use std::sync::Arc;
 pub use super::front::ast::BaseTy;
 
 /// A symbol: interned immutable text. Equal symbols share one address, so equality is a
-/// pointer comparison and hashing reads a hash of the text computed once (the same on every
-/// machine, so hash-ordered work stays deterministic); order is by content. Interned text is
-/// never freed: a run holds the names of the models it reads.
-pub type Sym = ustr_fxhash::Ustr;
+/// pointer comparison and hashing reads a hash of the text computed once (FxHash, the same on
+/// every machine, so hash-ordered work stays deterministic); order is by content, with equal
+/// symbols found equal without reading their text. Interned text is never freed: a run holds
+/// the names of the models it reads.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Sym(ustr_fxhash::Ustr);
+
+impl Sym {
+    pub fn as_str(&self) -> &'static str {
+        self.0.as_str()
+    }
+}
+
+impl From<&str> for Sym {
+    fn from(s: &str) -> Sym {
+        Sym(ustr_fxhash::Ustr::from(s))
+    }
+}
+
+impl std::ops::Deref for Sym {
+    type Target = str;
+    fn deref(&self) -> &str {
+        self.0.as_str()
+    }
+}
+
+impl AsRef<str> for Sym {
+    fn as_ref(&self) -> &str {
+        self.0.as_str()
+    }
+}
+
+impl Ord for Sym {
+    fn cmp(&self, o: &Self) -> Ordering {
+        if self.0 == o.0 {
+            Ordering::Equal
+        } else {
+            self.as_str().cmp(o.as_str())
+        }
+    }
+}
+
+impl PartialOrd for Sym {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl fmt::Debug for Sym {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self.as_str(), f)
+    }
+}
+
+impl fmt::Display for Sym {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
 
 /// A float column value with a total order and bitwise hash.
 #[derive(Clone, Copy, Debug, Default)]
@@ -158,7 +213,7 @@ impl OBox {
 float_tuple_traits!(OBox);
 
 /// One value of a tuple. Geometry is behind `Arc` to keep the enum small.
-#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Value {
     Number(i64),
     Unsigned(u64),
@@ -167,21 +222,6 @@ pub enum Value {
     Vec3(Vec3),
     Iso(Arc<Iso>),
     Box(Arc<OBox>),
-}
-
-/// As derived, with a symbol shown as its text (`Symbol("a")`).
-impl fmt::Debug for Value {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Value::Number(n) => f.debug_tuple("Number").field(n).finish(),
-            Value::Unsigned(n) => f.debug_tuple("Unsigned").field(n).finish(),
-            Value::Float(x) => f.debug_tuple("Float").field(x).finish(),
-            Value::Symbol(s) => f.debug_tuple("Symbol").field(&s.as_str()).finish(),
-            Value::Vec3(v) => f.debug_tuple("Vec3").field(v).finish(),
-            Value::Iso(i) => f.debug_tuple("Iso").field(i).finish(),
-            Value::Box(b) => f.debug_tuple("Box").field(b).finish(),
-        }
-    }
 }
 
 impl Value {
