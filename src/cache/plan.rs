@@ -337,26 +337,41 @@ fn shares(partition: &Partition, parts: &[usize], out: &Relations) -> Vec<Vec<(u
         _ => None,
     };
     let everyone: Vec<usize> = (0..parts.len()).collect();
-    let mut shares: Vec<Vec<(usize, usize)>> = vec![Vec::new(); parts.len()];
-    for (slot, (name, rows)) in out.iter().enumerate() {
-        for (row, t) in rows.iter().enumerate() {
-            let to: &[usize] = if name == REACH {
-                t.first()
-                    .and_then(symbol)
-                    .and_then(|c| of_container.get(&c))
-                    .map_or(&[], Vec::as_slice)
-            } else {
-                match t.iter().find_map(|v| symbol(v).and_then(|s| owner.get(&s))) {
-                    Some(k) => std::slice::from_ref(k),
-                    None => &everyone,
+    // Each relation's rows to their parts (relations in parallel), then each part's rows laid
+    // out in relation order.
+    let rows_of: Vec<Vec<Vec<usize>>> = out
+        .par_iter()
+        .map(|(name, rows)| {
+            let mut to_parts: Vec<Vec<usize>> = vec![Vec::new(); parts.len()];
+            for (row, t) in rows.iter().enumerate() {
+                let to: &[usize] = if name == REACH {
+                    t.first()
+                        .and_then(symbol)
+                        .and_then(|c| of_container.get(&c))
+                        .map_or(&[], Vec::as_slice)
+                } else {
+                    match t.iter().find_map(|v| symbol(v).and_then(|s| owner.get(&s))) {
+                        Some(k) => std::slice::from_ref(k),
+                        None => &everyone,
+                    }
+                };
+                for &k in to {
+                    to_parts[k].push(row);
                 }
-            };
-            for &k in to {
-                shares[k].push((slot, row));
             }
-        }
-    }
-    shares
+            to_parts
+        })
+        .collect();
+    (0..parts.len())
+        .into_par_iter()
+        .map(|k| {
+            rows_of
+                .iter()
+                .enumerate()
+                .flat_map(|(slot, to_parts)| to_parts[k].iter().map(move |&row| (slot, row)))
+                .collect()
+        })
+        .collect()
 }
 
 /// A part's share of `out` as its own relations (every relation of `out`, maybe empty).
