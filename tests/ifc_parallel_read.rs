@@ -2,9 +2,9 @@
 //! reads as one pass would: pieces in file order, and each bad product skipped with one
 //! warning naming it. Checked on a generated block model (several runs of products), with
 //! products in different runs stripped of their geometry.
+mod common;
+
 use framewright::ifc::Model;
-use framewright::synth::building::{BlockSpec, blocks};
-use framewright::synth::{Grouping, WriteOptions, models, write_ifc};
 
 /// The attributes of a STEP instance's parameter list, split at top-level commas.
 fn attributes(params: &str) -> Vec<&str> {
@@ -28,25 +28,22 @@ fn attributes(params: &str) -> Vec<&str> {
 
 #[test]
 fn products_in_every_run_read_as_one_pass_reads_them() {
-    let spec = BlockSpec {
-        unit: models::default_building_spec(),
-        blocks: 2,
-        storeys: 3,
-        rows: 1,
-        cols: 2,
-        gap: 3.0,
-        floor_depth: 0.3,
-    };
-    let layout = blocks(&spec, "runs").expect("layout");
-    let written = write_ifc(
-        &layout,
-        &WriteOptions {
-            grouping: Grouping::Wall,
-            ..WriteOptions::default()
-        },
-    )
-    .expect("write");
-    let text = written.ifc;
+    // Two blocks of four storeys of 1 x 2 units, members grouped in their walls.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = common::synth_block(
+        dir.path(),
+        &[
+            "--grouping",
+            "wall",
+            "--blocks",
+            "2",
+            "--storeys",
+            "4",
+            "--grid",
+            "1x2",
+        ],
+    );
+    let text = std::fs::read_to_string(&path).expect("read the generated model");
     let members: Vec<usize> = text
         .lines()
         .enumerate()

@@ -332,10 +332,6 @@ fn shares(partition: &Partition, parts: &[usize], out: &Relations) -> Vec<Vec<(u
         let container = Sym::from(partition.containers[part.container].name.as_str());
         of_container.entry(container).or_default().push(k);
     }
-    let symbol = |v: &Value| match v {
-        Value::Symbol(s) => Some(*s),
-        _ => None,
-    };
     let everyone: Vec<usize> = (0..parts.len()).collect();
     // Each relation's rows to their parts (relations in parallel), then each part's rows laid
     // out in relation order.
@@ -346,11 +342,14 @@ fn shares(partition: &Partition, parts: &[usize], out: &Relations) -> Vec<Vec<(u
             for (row, t) in rows.iter().enumerate() {
                 let to: &[usize] = if name == REACH {
                     t.first()
-                        .and_then(symbol)
+                        .and_then(Value::as_sym)
                         .and_then(|c| of_container.get(&c))
                         .map_or(&[], Vec::as_slice)
                 } else {
-                    match t.iter().find_map(|v| symbol(v).and_then(|s| owner.get(&s))) {
+                    match t
+                        .iter()
+                        .find_map(|v| v.as_sym().and_then(|s| owner.get(&s)))
+                    {
                         Some(k) => std::slice::from_ref(k),
                         None => &everyone,
                     }

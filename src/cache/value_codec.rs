@@ -152,7 +152,7 @@ impl<'a> Reader<'a> {
             0 => Value::Number(self.u64()? as i64),
             1 => Value::Unsigned(self.u64()?),
             2 => Value::Float(F64(self.f64()?)),
-            3 => Value::Symbol(crate::logic::value::Sym::from(self.str()?)),
+            3 => Value::sym(self.str()?),
             4 => Value::Vec3(Vec3::new(self.f64()?, self.f64()?, self.f64()?)),
             5 => Value::Iso(Arc::new(Iso(self.iso()?))),
             6 => {

@@ -120,9 +120,9 @@ fn split_by_container(tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Vec<Re
         }
     }
     let n = part_names.len().max(1);
-    let part_of = |v: Option<&Value>| match v {
-        Some(Value::Symbol(p)) => part_of_piece.get(p).copied(),
-        _ => None,
+    let part_of = |v: Option<&Value>| {
+        v.and_then(Value::as_sym)
+            .and_then(|p| part_of_piece.get(&p).copied())
     };
     let mut parts: Vec<Relations> = vec![Relations::new(); n];
     for (name, relation) in tuples {
@@ -174,7 +174,7 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
     use rayon::prelude::*;
     let pieces = model.pieces();
     let ids: Vec<Value> = pieces.par_iter().map(|p| sym(&p.id)).collect();
-    // A fixed run size: how symbols are shared must not follow the machine's threads.
+    // A fixed run size, so the runs never follow the machine's threads.
     const PER_RUN: usize = 1024;
     let piece_runs: Vec<Facts> = pieces
         .par_chunks(PER_RUN)
@@ -183,10 +183,8 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
         .map(|(run, (pieces_of_run, ids_of_run))| {
             let first = run * PER_RUN;
             let mut facts = Facts::default();
-            // Names that repeat (types, materials, containers) share one symbol.
-            let mut names = Symbols::default();
             for (k, (p, id)) in pieces_of_run.iter().zip(ids_of_run).enumerate() {
-                add_piece_facts(&mut facts, &mut names, model, first + k, p, id);
+                add_piece_facts(&mut facts, model, first + k, p, id);
             }
             facts
         })
@@ -197,9 +195,8 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
         .par_chunks(PER_RUN)
         .map(|run| {
             let mut facts = Facts::default();
-            let mut names = Symbols::default();
             for c in run {
-                add_contact_facts(&mut facts, &mut names, model, &ids, c);
+                add_contact_facts(&mut facts, model, &ids, c);
             }
             facts
         })
@@ -216,7 +213,6 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
 /// The facts of piece `index` of the model.
 fn add_piece_facts(
     facts: &mut Facts,
-    names: &mut Symbols,
     model: &Model,
     index: usize,
     p: &crate::ifc::Piece,
@@ -228,8 +224,8 @@ fn add_piece_facts(
         vec![
             id.clone(),
             Value::Number(p.entity as i64),
-            names.get(&p.ifc_type),
-            names.text(&p.name),
+            sym(&p.ifc_type),
+            text(&p.name),
         ],
         origin.clone(),
     );
@@ -255,11 +251,7 @@ fn add_piece_facts(
     );
     facts.add(
         "piece_type",
-        vec![
-            id.clone(),
-            names.text(&p.predefined_type),
-            names.text(&p.object_type),
-        ],
+        vec![id.clone(), text(&p.predefined_type), text(&p.object_type)],
         origin.clone(),
     );
     if let Some(group) = p.parent.and_then(|g| model.groups.get(&g)) {
@@ -267,9 +259,9 @@ fn add_piece_facts(
             "piece_group",
             vec![
                 id.clone(),
-                names.get(&group.global_id),
-                names.get(&group.ifc_type),
-                names.text(&group.name),
+                sym(&group.global_id),
+                sym(&group.ifc_type),
+                text(&group.name),
             ],
             Origin::Entity(group.entity),
         );
@@ -279,29 +271,23 @@ fn add_piece_facts(
         "piece_container",
         vec![
             id.clone(),
-            names.get(container.map_or("", |c| c.global_id.as_str())),
+            sym(container.map_or("", |c| c.global_id.as_str())),
         ],
         container.map_or(origin.clone(), |c| Origin::Entity(c.entity)),
     );
     let (density, _) = density_of(p.material.as_deref());
     facts.add(
         "piece_material",
-        vec![id.clone(), names.text(&p.material), Value::float(density)],
+        vec![id.clone(), text(&p.material), Value::float(density)],
         origin,
     );
 }
 
 /// The two `contact` facts of a touching pair, one from each side.
-fn add_contact_facts(
-    facts: &mut Facts,
-    names: &mut Symbols,
-    model: &Model,
-    ids: &[Value],
-    c: &crate::geom::Contact,
-) {
+fn add_contact_facts(facts: &mut Facts, model: &Model, ids: &[Value], c: &crate::geom::Contact) {
     let (a, b) = (&model.pieces()[c.a], &model.pieces()[c.b]);
-    let kind = names.get(c.kind.name());
-    let (face_a, face_b) = (names.get(c.face_a.name()), names.get(c.face_b.name()));
+    let kind = sym(c.kind.name());
+    let (face_a, face_b) = (sym(c.face_a.name()), sym(c.face_b.name()));
     facts.add(
         "contact",
         vec![
@@ -332,22 +318,7 @@ fn add_contact_facts(
     );
 }
 
-/// One symbol per distinct name: fewer allocations to make and to free.
-#[derive(Default)]
-struct Symbols(FxHashMap<String, Value>);
-
-impl Symbols {
-    fn get(&mut self, name: &str) -> Value {
-        if let Some(v) = self.0.get(name) {
-            return v.clone();
-        }
-        let v = sym(name);
-        self.0.insert(name.to_string(), v.clone());
-        v
-    }
-
-    /// An optional text, "" when absent.
-    fn text(&mut self, text: &Option<String>) -> Value {
-        self.get(text.as_deref().unwrap_or(""))
-    }
+/// An optional text as a symbol, "" when absent.
+fn text(text: &Option<String>) -> Value {
+    sym(text.as_deref().unwrap_or(""))
 }

@@ -84,9 +84,9 @@ impl Partition {
         }
 
         let mut sets = UnionFind::new(pieces.len());
-        let find = |v: Option<&Value>| match v {
-            Some(Value::Symbol(p)) => piece_index.get(p).copied(),
-            _ => None,
+        let find = |v: Option<&Value>| {
+            v.and_then(Value::as_sym)
+                .and_then(|p| piece_index.get(&p).copied())
         };
         let mut across: Vec<Vec<Vector3<f64>>> = vec![Vec::new(); pieces.len()];
         for (t, _) in facts.tuples.get("piece_box").into_iter().flatten() {

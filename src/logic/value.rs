@@ -293,6 +293,13 @@ impl Value {
             _ => None,
         }
     }
+    /// The symbol itself (a copy of its handle), for maps keyed by symbol.
+    pub fn as_sym(&self) -> Option<Sym> {
+        match self {
+            Value::Symbol(s) => Some(*s),
+            _ => None,
+        }
+    }
 
     /// Parse a field of a `.facts` file as a value of type `ty`.
     pub fn parse(ty: BaseTy, text: &str) -> Result<Value, String> {

@@ -352,7 +352,7 @@ fn expr(e: &Expr, slots: &mut Slots) -> CExpr {
             _ => Value::Number(*i as i64),
         }),
         ExprKind::Float(f) => CExpr::Const(Value::float(*f)),
-        ExprKind::Str(s) => CExpr::Const(Value::Symbol(crate::logic::value::Sym::from(s.as_str()))),
+        ExprKind::Str(s) => CExpr::Const(Value::sym(s)),
         ExprKind::Neg(x) => CExpr::Neg(ty, Box::new(expr(x, slots))),
         ExprKind::Bin(op, a, b) => {
             CExpr::Bin(*op, ty, Box::new(expr(a, slots)), Box::new(expr(b, slots)))
