@@ -11,7 +11,7 @@ use super::key::build_id_noted;
 use super::value_codec::{Reader, put_relations, put_str, put_tuple, put_u64};
 use super::{Cache, CacheCounts};
 use crate::cell::{Cell, OffsetX};
-use crate::frame::partition::{Part, Partition};
+use crate::frame::partition::{Indices, Partition};
 use crate::frame::placement::{
     FIRST_PASS, SearchMemo, SearchOptions, placement_relations, reason_placed,
 };
@@ -42,12 +42,17 @@ pub fn reason_plan_cached(
     cache: &Cache,
     limits: &RuleLimits,
 ) -> Result<(Reasoned, CacheCounts), FrameError> {
-    let mut partition = Partition::of(&facts);
-    let base = base_key(cell, build_id_noted(cache.dir()), limits);
-    let keys: Vec<String> = partition
-        .parts
-        .par_iter()
-        .map(|p| part_key(&base, p))
+    let partition = Partition::of(&facts);
+    let base = base_key(
+        cell,
+        build_id_noted(cache.dir()),
+        limits,
+        &partition,
+        &facts,
+    );
+    let keys: Vec<String> = (0..partition.parts.len())
+        .into_par_iter()
+        .map(|i| part_key(&base, &partition, &facts, i))
         .collect();
     let extents = Extents::of(&facts, &partition);
     let mut counts = CacheCounts::default();
@@ -81,7 +86,7 @@ pub fn reason_plan_cached(
         .sum();
 
     if results.iter().all(Option::is_none) {
-        return first_run(facts, cell, cache, limits, &mut partition, &keys, &rejected);
+        return first_run(facts, cell, cache, limits, &partition, &keys, &rejected);
     }
 
     // What to compute: whole containers where many parts missed, single parts elsewhere.
@@ -163,15 +168,11 @@ fn first_run(
     cell: &Cell,
     cache: &Cache,
     limits: &RuleLimits,
-    partition: &mut Partition,
+    partition: &Partition,
     keys: &[String],
     rejected: &[bool],
 ) -> Result<(Reasoned, CacheCounts), FrameError> {
     let mut counts = CacheCounts::default();
-    // The parts' own copies of the facts are not needed any more: keys are made.
-    for part in &mut partition.parts {
-        part.relations = Relations::new();
-    }
     let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
     wanted.push(REACH);
     let mut reasoned = reason_placed(facts, cell, &RuleEngine::Compiled, &wanted, limits)?;
@@ -224,40 +225,9 @@ impl Job {
     ) -> Result<(Vec<(usize, Relations)>, u64), FrameError> {
         match self {
             Job::Container { parts, .. } => {
-                // The parts' facts, with the file's piece indices: the parts' own start at 0
-                // each, and the rules take a wall's name from the piece of its least index.
-                let mut input = Relations::new();
-                let mut pieces: FxHashSet<&str> = FxHashSet::default();
-                for &i in parts {
-                    let part = &partition.parts[i];
-                    pieces.extend(part.pieces.iter().map(String::as_str));
-                    for (name, tuples) in &part.relations {
-                        if name != "piece_index" {
-                            input
-                                .entry(name.clone())
-                                .or_default()
-                                .extend(tuples.iter().cloned());
-                        }
-                    }
-                }
-                // Every part holds the cell's facts: once is enough (the program's input
-                // tables keep duplicates, and its joins would repeat them).
-                for tuples in input.values_mut() {
-                    tuples.sort();
-                    tuples.dedup();
-                }
-                let indices = facts.tuples.get("piece_index").into_iter().flatten();
-                input.insert(
-                    "piece_index".into(),
-                    indices
-                        .filter(|(t, _)| {
-                            t.first()
-                                .and_then(Value::as_symbol)
-                                .is_some_and(|p| pieces.contains(p))
-                        })
-                        .map(|(t, _)| t.clone())
-                        .collect(),
-                );
+                // The parts' facts, with the file's piece indices: the rules take a wall's
+                // name from the piece of its least index.
+                let input = partition.relations(facts, parts, Indices::File);
                 let (out, tuples) = reason_part(input, cell, memo)?;
                 let shares = shares(partition, parts, &out);
                 let split = parts
@@ -268,7 +238,7 @@ impl Job {
                 Ok((split, tuples))
             }
             Job::Part(i) => {
-                let mut input = partition.parts[*i].relations.clone();
+                let mut input = partition.relations(facts, &[*i], Indices::Renumbered);
                 let context = partition.context(facts, *i);
                 let others: FxHashSet<&str> = context
                     .get("piece_container")
@@ -429,10 +399,17 @@ fn merge(partition: &Partition, results: Vec<Option<Relations>>) -> Relations {
 }
 
 /// What every part's key shares: the format, the build, the cell (its facts and what the
-/// placement search reads: robot, tool, offsets), the search options, and the rule tuple
-/// bound (a run under a lower bound must stop where an uncached run stops, not read a result
-/// derived under a higher one; the wall bound is checked on every run).
-fn base_key(cell: &Cell, build: &str, limits: &RuleLimits) -> blake3::Hasher {
+/// placement search reads: robot, tool, offsets), the search options, the rule tuple bound (a
+/// run under a lower bound must stop where an uncached run stops, not read a result derived
+/// under a higher one; the wall bound is checked on every run), and the facts every part
+/// reads (those about no piece).
+fn base_key(
+    cell: &Cell,
+    build: &str,
+    limits: &RuleLimits,
+    partition: &Partition,
+    facts: &Facts,
+) -> blake3::Hasher {
     let mut h = blake3::Hasher::new();
     h.update(b"framewright plan part\0");
     h.update(build.as_bytes());
@@ -444,14 +421,29 @@ fn base_key(cell: &Cell, build: &str, limits: &RuleLimits) -> blake3::Hasher {
         )
         .as_bytes(),
     );
+    let common = partition.common_rows(facts);
+    let mut bytes = Vec::new();
+    put_u64(&mut bytes, common.len() as u64);
+    for (name, rows) in common {
+        put_str(&mut bytes, name);
+        put_u64(&mut bytes, rows.len() as u64);
+        rows.into_iter().for_each(|t| put_tuple(&mut bytes, t));
+    }
+    h.update(&bytes);
     h
 }
 
-/// A part's key: the base and its facts, byte for byte.
-fn part_key(base: &blake3::Hasher, part: &Part) -> String {
-    let mut h = base.clone();
+/// A part's key: the base and the part's own facts, byte for byte.
+fn part_key(base: &blake3::Hasher, partition: &Partition, facts: &Facts, i: usize) -> String {
+    let own = partition.own_rows(facts, i);
     let mut bytes = Vec::new();
-    put_relations(&mut bytes, &part.relations);
+    put_u64(&mut bytes, own.len() as u64);
+    for (name, rows) in own {
+        put_str(&mut bytes, name);
+        put_u64(&mut bytes, rows.len() as u64);
+        rows.iter().for_each(|t| put_tuple(&mut bytes, t));
+    }
+    let mut h = base.clone();
     h.update(&bytes);
     h.finalize().to_hex().to_string()
 }

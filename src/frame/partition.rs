@@ -18,6 +18,7 @@ use crate::logic::{OBox, Value};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
+use std::borrow::Cow;
 
 /// One independent part of a container.
 pub struct Part {
@@ -27,11 +28,21 @@ pub struct Part {
     pub pieces: Vec<String>,
     /// The IFC groups (IfcWall, IfcElementAssembly) its pieces belong to.
     pub groups: Vec<String>,
-    /// Its facts: its pieces' tuples, their contacts, the facts about no piece (the cell);
-    /// `piece_index` renumbered from 0 in file order within the part (the rules only compare
+    /// Its own facts, per relation of the model's (`Partition::names`): the indices of the
+    /// tuples about its pieces (a contact only between two of them), sorted by content,
+    /// without repeats. Indices, not copies: most parts are only hashed.
+    own: Vec<Vec<u32>>,
+}
+
+/// How `Partition::relations` numbers pieces.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Indices {
+    /// `piece_index` renumbered from 0 in file order within the parts (the rules only compare
     /// indices of pieces of one wall, and no relation `plan` reads carries one), so that an
-    /// edit elsewhere in the file does not change the part.
-    pub relations: Relations,
+    /// edit elsewhere in the file does not change them.
+    Renumbered,
+    /// The file's indices (the rules take a wall's name from the piece of its least index).
+    File,
 }
 
 /// A container (storey, building, or "" for none) and its pieces.
@@ -47,6 +58,11 @@ pub struct Partition {
     /// Every piece id, in `piece_container` order.
     pub pieces: Vec<String>,
     pub parts: Vec<Part>,
+    /// The model's relations, in name order: what `Part::own` and `common` index.
+    names: Vec<&'static str>,
+    /// Per relation, the indices of the tuples about no piece (the cell's): every part reads
+    /// them.
+    common: Vec<Vec<u32>>,
 }
 
 /// Relations that hold a piece's context facts: what `storey_reach` reads.
@@ -124,7 +140,7 @@ impl Partition {
                     container: container_of[i],
                     pieces: Vec::new(),
                     groups: Vec::new(),
-                    relations: Relations::new(),
+                    own: Vec::new(),
                 });
             }
             parts[k].pieces.push(piece.clone());
@@ -141,43 +157,115 @@ impl Partition {
             parts[k].groups = groups;
         }
 
-        // Each relation split into its parts' buckets, relations and buckets in parallel.
-        let split: Vec<(&str, Vec<Vec<Vec<Value>>>)> = facts
+        // Each relation split into its parts' buckets, relations in parallel.
+        let split: Vec<(Vec<Vec<u32>>, Vec<u32>)> = facts
             .tuples
             .par_iter()
             .map(|(name, tuples)| {
-                let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); parts.len()];
-                for (tuple, _) in tuples {
+                let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); parts.len()];
+                let mut common: Vec<u32> = Vec::new();
+                for (j, (tuple, _)) in tuples.iter().enumerate() {
+                    let j = j as u32;
                     match find(tuple.first()).map(|p| part_of[p]) {
                         Some(k) if *name == "contact" => {
                             if find(tuple.get(1)).map(|p| part_of[p]) == Some(k) {
-                                buckets[k].push(tuple.clone());
+                                buckets[k].push(j);
                             }
                         }
-                        Some(k) => buckets[k].push(tuple.clone()),
-                        None => buckets.iter_mut().for_each(|b| b.push(tuple.clone())),
+                        Some(k) => buckets[k].push(j),
+                        None => common.push(j),
                     }
                 }
-                buckets.par_iter_mut().for_each(|bucket| {
-                    if *name == "piece_index" {
-                        renumber(bucket);
-                    }
-                    bucket.sort();
-                    bucket.dedup();
-                });
-                (*name, buckets)
+                let by_content = |rows: &mut Vec<u32>| {
+                    rows.sort_by(|&a, &b| tuples[a as usize].0.cmp(&tuples[b as usize].0));
+                    rows.dedup_by(|a, b| tuples[*a as usize].0 == tuples[*b as usize].0);
+                };
+                buckets.par_iter_mut().for_each(by_content);
+                by_content(&mut common);
+                (buckets, common)
             })
             .collect();
-        for (name, buckets) in split {
+        let names: Vec<&'static str> = facts.tuples.keys().copied().collect();
+        let mut common = Vec::with_capacity(names.len());
+        for (buckets, shared) in split {
             for (part, bucket) in parts.iter_mut().zip(buckets) {
-                part.relations.insert(name.to_string(), bucket);
+                part.own.push(bucket);
             }
+            common.push(shared);
         }
         Partition {
             containers,
             pieces,
             parts,
+            names,
+            common,
         }
+    }
+
+    /// The own facts of part `i`, per relation in name order, `piece_index` renumbered
+    /// (`Indices::Renumbered`). With `common_rows` they are exactly the part's facts.
+    pub fn own_rows<'f>(
+        &self,
+        facts: &'f Facts,
+        i: usize,
+    ) -> Vec<(&'static str, Vec<Cow<'f, [Value]>>)> {
+        self.names
+            .iter()
+            .zip(&self.parts[i].own)
+            .map(|(name, rows)| {
+                let tuples = &facts.tuples[name];
+                let mut out: Vec<Cow<[Value]>> = rows
+                    .iter()
+                    .map(|&j| Cow::Borrowed(tuples[j as usize].0.as_slice()))
+                    .collect();
+                if *name == "piece_index" {
+                    renumber(&mut out);
+                }
+                (*name, out)
+            })
+            .collect()
+    }
+
+    /// The facts about no piece (the cell's), per relation in name order, sorted.
+    pub fn common_rows<'f>(&self, facts: &'f Facts) -> Vec<(&'static str, Vec<&'f [Value]>)> {
+        self.names
+            .iter()
+            .zip(&self.common)
+            .map(|(name, rows)| {
+                let tuples = &facts.tuples[name];
+                let out = rows
+                    .iter()
+                    .map(|&j| tuples[j as usize].0.as_slice())
+                    .collect();
+                (*name, out)
+            })
+            .collect()
+    }
+
+    /// The facts of `parts` together (each part's own and the common ones), every relation
+    /// sorted, without repeats: the input of a run over them.
+    pub fn relations(&self, facts: &Facts, parts: &[usize], indices: Indices) -> Relations {
+        self.names
+            .iter()
+            .enumerate()
+            .map(|(r, name)| {
+                let all = &facts.tuples[name];
+                let mut tuples: Vec<Vec<Value>> = parts
+                    .iter()
+                    .flat_map(|&i| &self.parts[i].own[r])
+                    .chain(&self.common[r])
+                    .map(|&j| all[j as usize].0.clone())
+                    .collect();
+                if *name == "piece_index" && indices == Indices::Renumbered {
+                    tuples.sort();
+                    tuples.dedup();
+                    renumber(&mut tuples);
+                }
+                tuples.sort();
+                tuples.dedup();
+                (name.to_string(), tuples)
+            })
+            .collect()
     }
 
     /// The context facts of `part`: the boxes, sizes and container of every other piece of its
@@ -245,16 +333,24 @@ fn may_be_coplanar(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> bool {
         .any(|da| b.iter().any(|db| da.dot(db).abs() > 0.99 - MARGIN))
 }
 
-/// `piece_index` tuples renumbered 0.. in the order of their indices.
-fn renumber(tuples: &mut [Vec<Value>]) {
+/// `piece_index` tuples renumbered 0.. in the order of their indices (ties in the order
+/// given).
+fn renumber<T: AsRef<[Value]> + From<Vec<Value>>>(tuples: &mut [T]) {
     let mut order: Vec<(i64, usize)> = tuples
         .iter()
         .enumerate()
-        .map(|(k, t)| (t.get(1).and_then(Value::as_number).unwrap_or(i64::MAX), k))
+        .map(|(k, t)| {
+            let index = t.as_ref().get(1).and_then(Value::as_number);
+            (index.unwrap_or(i64::MAX), k)
+        })
         .collect();
     order.sort();
     for (rank, (_, k)) in order.into_iter().enumerate() {
-        tuples[k][1] = Value::Number(rank as i64);
+        let mut t = tuples[k].as_ref().to_vec();
+        if let Some(index) = t.get_mut(1) {
+            *index = Value::Number(rank as i64);
+        }
+        tuples[k] = T::from(t);
     }
 }
 
@@ -352,18 +448,40 @@ mod tests {
         assert_eq!(p.parts[1].groups, vec!["G"]);
         // The contact across containers and the one across walls (a crossing upright) go
         // nowhere; the cell goes everywhere.
-        assert_eq!(p.parts[0].relations["contact"].len(), 1);
-        assert!(p.parts[2].relations["contact"].is_empty());
-        assert!(p.parts[3].relations["contact"].is_empty());
-        assert!(p.parts.iter().all(|q| q.relations["cell_value"].len() == 1));
-        // Indices renumbered within the part, in file order.
-        let idx = &p.parts[1].relations["piece_index"];
+        let of = |k: usize| p.relations(&f, &[k], Indices::Renumbered);
+        assert_eq!(of(0)["contact"].len(), 1);
+        assert!(of(2)["contact"].is_empty());
+        assert!(of(3)["contact"].is_empty());
+        assert!((0..p.parts.len()).all(|k| of(k)["cell_value"].len() == 1));
+        // Indices renumbered within the part, in file order; or kept.
+        let renumbered = vec![
+            vec![s("c"), Value::Number(1)],
+            vec![s("d"), Value::Number(0)],
+        ];
+        assert_eq!(of(1)["piece_index"], renumbered);
+        let own = p.own_rows(&f, 1);
+        let (_, rows) = own.iter().find(|(n, _)| *n == "piece_index").unwrap();
         assert_eq!(
-            idx,
-            &vec![
-                vec![s("c"), Value::Number(1)],
-                vec![s("d"), Value::Number(0)]
+            rows.iter().map(|t| t.to_vec()).collect::<Vec<_>>(),
+            renumbered
+        );
+        let kept = p.relations(&f, &[0, 1], Indices::File);
+        assert_eq!(
+            kept["piece_index"],
+            vec![
+                vec![s("a"), Value::Number(4)],
+                vec![s("c"), Value::Number(9)],
+                vec![s("d"), Value::Number(7)]
             ]
+        );
+        // The cell's facts are common, not any part's own.
+        let common = p.common_rows(&f);
+        let (_, rows) = common.iter().find(|(n, _)| *n == "cell_value").unwrap();
+        assert_eq!(rows.len(), 1);
+        assert!(
+            p.own_rows(&f, 0)
+                .iter()
+                .all(|(n, r)| *n != "cell_value" || r.is_empty())
         );
         // Context of part 0: the other pieces of S1 (c, d, f), never e or a, b.
         let ctx = p.context(&f, 0);
