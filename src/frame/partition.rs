@@ -29,8 +29,10 @@ pub struct Part {
     /// The IFC groups (IfcWall, IfcElementAssembly) its pieces belong to.
     pub groups: Vec<String>,
     /// Its own facts, per relation of the model's (`Partition::names`): the indices of the
-    /// tuples about its pieces (a contact only between two of them), sorted by content,
-    /// without repeats. Indices, not copies: most parts are only hashed.
+    /// tuples about its pieces (a contact only between two of them), in the facts' order.
+    /// Indices, not copies: most parts are only hashed. Not sorted: the facts keep the order
+    /// of the file's pieces, so a part's rows come in the same order as long as its own
+    /// pieces keep theirs (when they do not, its `piece_index` changes anyway).
     own: Vec<Vec<u32>>,
 }
 
@@ -176,12 +178,6 @@ impl Partition {
                         None => common.push(j),
                     }
                 }
-                let by_content = |rows: &mut Vec<u32>| {
-                    rows.sort_by(|&a, &b| tuples[a as usize].0.cmp(&tuples[b as usize].0));
-                    rows.dedup_by(|a, b| tuples[*a as usize].0 == tuples[*b as usize].0);
-                };
-                buckets.par_iter_mut().for_each(by_content);
-                by_content(&mut common);
                 (buckets, common)
             })
             .collect();
@@ -226,7 +222,7 @@ impl Partition {
             .collect()
     }
 
-    /// The facts about no piece (the cell's), per relation in name order, sorted.
+    /// The facts about no piece (the cell's), per relation in name order.
     pub fn common_rows<'f>(&self, facts: &'f Facts) -> Vec<(&'static str, Vec<&'f [Value]>)> {
         self.names
             .iter()
