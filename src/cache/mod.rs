@@ -10,7 +10,7 @@ pub mod store;
 pub mod trace_codec;
 pub mod value_codec;
 
-pub use plan::reason_plan_cached;
+pub use plan::{reason_plan_cached, reason_plan_cached_with};
 pub use sim::{
     CacheCounts, Need, Shard, ShardRun, cached_simulation, simulate_cached, simulate_cached_for,
     simulate_shard,

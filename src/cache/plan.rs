@@ -42,6 +42,20 @@ pub fn reason_plan_cached(
     cache: &Cache,
     limits: &RuleLimits,
 ) -> Result<(Reasoned, CacheCounts), FrameError> {
+    let (reasoned, counts, ()) = reason_plan_cached_with(facts, cell, cache, limits, |_| ())?;
+    Ok((reasoned, counts))
+}
+
+/// `reason_plan_cached`, and `then` called on the reasoned relations (`Plan::RELATIONS`, maybe
+/// more). A first run calls it while it splits and encodes its entries, so the caller's next
+/// step (building the plan) runs beside the cache's own work.
+pub fn reason_plan_cached_with<T: Send>(
+    facts: Facts,
+    cell: &Cell,
+    cache: &Cache,
+    limits: &RuleLimits,
+    then: impl FnOnce(&Relations) -> T + Send,
+) -> Result<(Reasoned, CacheCounts, T), FrameError> {
     let partition = Partition::of(&facts);
     let base = base_key(
         cell,
@@ -86,7 +100,13 @@ pub fn reason_plan_cached(
         .sum();
 
     if results.iter().all(Option::is_none) {
-        return first_run(facts, cell, cache, limits, &partition, &keys, &rejected);
+        let stored = Stored {
+            cache,
+            partition: &partition,
+            keys: &keys,
+            rejected: &rejected,
+        };
+        return first_run(facts, cell, limits, stored, then);
     }
 
     // What to compute: whole containers where many parts missed, single parts elsewhere.
@@ -140,12 +160,14 @@ pub fn reason_plan_cached(
 
     let relations = merge(&partition, results);
     limits.check_walls(relations.get("wall").map_or(0, Vec::len) as u64)?;
+    let after = then(&relations);
     Ok((
         Reasoned {
             relations,
             engine: None,
         },
         counts,
+        after,
     ))
 }
 
@@ -161,42 +183,59 @@ fn poisoned() -> FrameError {
     FrameError::Compiled("a reasoning thread failed".into())
 }
 
+/// Where a first run stores its parts, and what the lookups found.
+struct Stored<'a> {
+    cache: &'a Cache,
+    partition: &'a Partition,
+    keys: &'a [String],
+    rejected: &'a [bool],
+}
+
 /// A first run (nothing cached): the model reasoned as `plan` does without the cache (one
-/// placement search over every wall, so repeated walls search once), its parts stored.
-fn first_run(
+/// placement search over every wall, so repeated walls search once), its parts stored while
+/// `then` runs.
+fn first_run<T: Send>(
     facts: Facts,
     cell: &Cell,
-    cache: &Cache,
     limits: &RuleLimits,
-    partition: &Partition,
-    keys: &[String],
-    rejected: &[bool],
-) -> Result<(Reasoned, CacheCounts), FrameError> {
-    let mut counts = CacheCounts::default();
+    stored: Stored,
+    then: impl FnOnce(&Relations) -> T + Send,
+) -> Result<(Reasoned, CacheCounts, T), FrameError> {
     let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
     wanted.push(REACH);
     let mut reasoned = reason_placed(facts, cell, &RuleEngine::Compiled, &wanted, limits)?;
-    let everything: Vec<usize> = (0..partition.parts.len()).collect();
-    let shares = shares(partition, &everything, &reasoned.relations);
-    let wall_slot = reasoned.relations.keys().position(|n| n == "wall");
-    // Encoded here, written on a thread of their own while the caller builds its plan.
+    let relations = &reasoned.relations;
+    let (rejected, after) = rayon::join(|| store_parts(relations, &stored), || then(relations));
+    reasoned.relations.remove(REACH);
+    let counts = CacheCounts {
+        computed: reasoned.get("wall").len(),
+        rejected,
+        ..CacheCounts::default()
+    };
+    Ok((reasoned, counts, after))
+}
+
+/// Splits a whole run's relations into the parts' entries, encodes them, and leaves them to
+/// be written behind; returns how many walls replace entries that were found rejected.
+fn store_parts(relations: &Relations, stored: &Stored) -> usize {
+    let everything: Vec<usize> = (0..stored.partition.parts.len()).collect();
+    let shares = shares(stored.partition, &everything, relations);
+    let wall_slot = relations.keys().position(|n| n == "wall");
+    let keys = stored.keys;
     let (walls, entries): (Vec<usize>, Vec<(String, Vec<u8>)>) = shares
         .par_iter()
         .enumerate()
         .map(|(i, share)| {
-            let bytes = encode_share(&keys[i], &reasoned.relations, share);
+            let bytes = encode_share(&keys[i], relations, share);
             let walls = share.iter().filter(|(r, _)| Some(*r) == wall_slot).count();
             (walls, (keys[i].clone(), bytes))
         })
         .unzip();
-    cache.put_plans_behind(entries);
-    counts.rejected = (0..walls.len())
-        .filter(|&i| rejected[i])
+    stored.cache.put_plans_behind(entries);
+    (0..walls.len())
+        .filter(|&i| stored.rejected[i])
         .map(|i| walls[i])
-        .sum();
-    reasoned.relations.remove(REACH);
-    counts.computed = reasoned.get("wall").len();
-    Ok((reasoned, counts))
+        .sum()
 }
 
 /// A unit of reasoning.

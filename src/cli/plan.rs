@@ -5,7 +5,7 @@
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::{ReasoningInputs, load_model_facts, rule_base};
 use super::{CmdResult, leave_to_exit, print_stdout, write_stdout};
-use framewright::cache::reason_plan_cached;
+use framewright::cache::reason_plan_cached_with;
 use framewright::frame::RuleLimits;
 use framewright::frame::placement::reason_placed;
 use framewright::frame::plan::Plan;
@@ -34,22 +34,23 @@ pub fn run(args: PlanArgs) -> CmdResult {
         None => args.cache.open(),
         Some(_) => None,
     };
-    let (reasoned, counts) = match &cache {
+    let limits = RuleLimits::from_env()?;
+    let (reasoned, counts, plan) = match &cache {
         Some(cache) => {
-            let (reasoned, counts) =
-                reason_plan_cached(facts, &cell, cache, &RuleLimits::from_env()?)?;
-            (reasoned, Some(counts))
+            // A first run stores its entries while the plan is built.
+            let (reasoned, counts, plan) =
+                reason_plan_cached_with(facts, &cell, cache, &limits, |relations| {
+                    Plan::from_relations(&model, relations)
+                })?;
+            (reasoned, Some(counts), plan)
         }
         None => {
             let engine = rule_base(&inputs.rules_dir);
-            let limits = RuleLimits::from_env()?;
-            (
-                reason_placed(facts, &cell, &engine, Plan::RELATIONS, &limits)?,
-                None,
-            )
+            let reasoned = reason_placed(facts, &cell, &engine, Plan::RELATIONS, &limits)?;
+            let plan = Plan::from_reasoned(&model, &reasoned);
+            (reasoned, None, plan)
         }
     };
-    let plan = Plan::from_reasoned(&model, &reasoned);
     let mut report = PlanReport::new(&model, &plan);
     report.cache = counts;
     let written = if args.json {

@@ -5,6 +5,7 @@ use super::Reasoned;
 use crate::geom::Point3;
 use crate::ifc::Model;
 use crate::logic::Value;
+use crate::logic::compiled::Relations;
 use nalgebra::{Isometry3, Vector3};
 use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
@@ -85,9 +86,13 @@ impl Plan {
 
     /// Collects the plan from the rule base's relations (missing relations give empty parts).
     pub fn from_reasoned(model: &Model, r: &Reasoned) -> Plan {
-        use rayon::prelude::*;
         // The relations alone (the interpreter `r` may hold is not shared between threads).
-        let relations = &r.relations;
+        Plan::from_relations(model, &r.relations)
+    }
+
+    /// `from_reasoned` on the relations alone (others than `RELATIONS` are not read).
+    pub fn from_relations(model: &Model, relations: &Relations) -> Plan {
+        use rayon::prelude::*;
         let get = |relation: &str| relations.get(relation).map_or(&[][..], Vec::as_slice);
         // Lookups borrow the relations' symbols; only what the plan keeps is copied.
         let index: FxHashMap<&str, usize> = model
@@ -249,8 +254,7 @@ impl Plan {
             .iter()
             .map(|(p, w)| (p.to_string(), wall_ids.get(w).unwrap_or(w).to_string()))
             .collect();
-        let mut warnings: Vec<String> = r
-            .get("frame_warning")
+        let mut warnings: Vec<String> = get("frame_warning")
             .iter()
             .map(|t| {
                 let subject = sym(&t[0]);
@@ -259,7 +263,7 @@ impl Plan {
             })
             .collect();
         if walls.is_empty() {
-            warnings.push(no_walls_reason(model, r));
+            warnings.push(no_walls_reason(model, relations));
         }
         Plan {
             walls,
@@ -272,14 +276,15 @@ impl Plan {
 }
 
 /// Why a model gave no wall frames, in the user's terms.
-fn no_walls_reason(model: &Model, r: &Reasoned) -> String {
+fn no_walls_reason(model: &Model, relations: &Relations) -> String {
+    let count = |relation: &str| relations.get(relation).map_or(0, Vec::len);
     let pieces = model.pieces().len();
     if pieces == 0 {
         return "no wall frames: the model holds no members, columns, beams, plates or proxies with solid geometry".into();
     }
-    let lumber = r.get("lumber").len();
-    let upright = r.get("across").len();
-    let coplanar = r.get("coplanar").len() / 2;
+    let lumber = count("lumber");
+    let upright = count("across");
+    let coplanar = count("coplanar") / 2;
     format!(
         "no wall frames: of {pieces} pieces, {lumber} have lumber sections, {upright} stand plumb or lie level in a wall plane, and {coplanar} pairs touch in one plane; a wall needs at least three lumber pieces (plates and studs) touching in one vertical plane"
     )
