@@ -8,7 +8,7 @@
 //! parts whose storey extent it moved), nothing else.
 
 use super::key::build_id_noted;
-use super::value_codec::{Reader, put_relations, put_str, put_tuple, put_u64};
+use super::value_codec::{Reader, Writer};
 use super::{Cache, CacheCounts};
 use crate::cell::{Cell, OffsetX};
 use crate::frame::partition::{Indices, Partition};
@@ -27,7 +27,7 @@ use std::sync::Mutex;
 /// The relation an entry's context check reads.
 const REACH: &str = crate::frame::rule_reads::STOREY_REACH;
 /// Start of every entry: the format.
-const MAGIC: &[u8] = b"framewright plan part 1\n";
+const MAGIC: &[u8] = b"framewright plan part 2\n";
 /// Above this share of missed parts a container is reasoned whole (one run, split into
 /// entries afterwards) instead of part by part (each part with its storey as context).
 const WHOLE_CONTAINER_SHARE: f64 = 0.25;
@@ -460,58 +460,56 @@ fn base_key(
         )
         .as_bytes(),
     );
-    let common = partition.common_rows(facts);
-    let mut bytes = Vec::new();
-    put_u64(&mut bytes, common.len() as u64);
-    for (name, rows) in common {
-        put_str(&mut bytes, name);
-        put_u64(&mut bytes, rows.len() as u64);
-        rows.into_iter().for_each(|t| put_tuple(&mut bytes, t));
-    }
-    h.update(&bytes);
+    let mut w = Writer::default();
+    write_named(&mut w, &partition.common_rows(facts));
+    h.update(&w.bytes);
     h
 }
 
 /// A part's key: the base and the part's own facts, byte for byte.
 fn part_key(base: &blake3::Hasher, partition: &Partition, facts: &Facts, i: usize) -> String {
-    let own = partition.own_rows(facts, i);
-    let mut bytes = Vec::new();
-    put_u64(&mut bytes, own.len() as u64);
-    for (name, rows) in own {
-        put_str(&mut bytes, name);
-        put_u64(&mut bytes, rows.len() as u64);
-        rows.iter().for_each(|t| put_tuple(&mut bytes, t));
-    }
+    let mut w = Writer::default();
+    write_named(&mut w, &partition.own_rows(facts, i));
     let mut h = base.clone();
-    h.update(&bytes);
+    h.update(&w.bytes);
     h.finalize().to_hex().to_string()
 }
 
+/// Relations given as (name, rows), written as `Writer::relations` writes a relation set.
+fn write_named<T: AsRef<[Value]>>(w: &mut Writer, named: &[(&str, Vec<T>)]) {
+    w.u64(named.len() as u64);
+    for (name, rows) in named {
+        w.str(name);
+        w.u64(rows.len() as u64);
+        rows.iter().for_each(|t| w.tuple(t.as_ref()));
+    }
+}
+
 fn encode(key: &str, relations: &Relations) -> Vec<u8> {
-    let mut out = MAGIC.to_vec();
-    put_str(&mut out, key);
-    put_relations(&mut out, relations);
-    seal(out)
+    let mut w = Writer::new(MAGIC.to_vec());
+    w.str(key);
+    w.relations(relations);
+    seal(w.bytes)
 }
 
 /// `encode` of a part's share of a run's relations, read in place.
 fn encode_share(key: &str, out: &Relations, share: &[(usize, usize)]) -> Vec<u8> {
-    let mut bytes = MAGIC.to_vec();
-    put_str(&mut bytes, key);
-    put_u64(&mut bytes, out.len() as u64);
+    let mut w = Writer::new(MAGIC.to_vec());
+    w.str(key);
+    w.u64(out.len() as u64);
     let mut next = 0;
     for (slot, (name, rows)) in out.iter().enumerate() {
         let start = next;
         while next < share.len() && share[next].0 == slot {
             next += 1;
         }
-        put_str(&mut bytes, name);
-        put_u64(&mut bytes, (next - start) as u64);
+        w.str(name);
+        w.u64((next - start) as u64);
         for &(_, row) in &share[start..next] {
-            put_tuple(&mut bytes, &rows[row]);
+            w.tuple(&rows[row]);
         }
     }
-    seal(bytes)
+    seal(w.bytes)
 }
 
 /// An entry's bytes followed by their blake3 digest.

@@ -1,106 +1,147 @@
-//! Rule tuples as bytes and back, exactly: floats as their bits, symbols as UTF-8 with their
-//! length. The same bytes feed the plan cache's keys (what a part's rules read) and its
+//! Rule tuples as bytes and back, exactly: floats as their bits, a symbol as UTF-8 with its
+//! length the first time and as a back-reference after. The same bytes feed the plan cache's keys (what a part's rules read) and its
 //! entries (what they derived).
 
 use crate::logic::Value;
 use crate::logic::compiled::Relations;
-use crate::logic::value::{F64, Iso, OBox, Vec3};
+use crate::logic::value::{F64, Iso, OBox, Sym, Vec3};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use rustc_hash::FxHashMap;
+use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
-/// Appends a relation set: count, then each relation's name, tuple count and tuples.
-pub fn put_relations(out: &mut Vec<u8>, relations: &Relations) {
-    put_u64(out, relations.len() as u64);
-    for (name, tuples) in relations {
-        put_str(out, name);
-        put_tuples(out, tuples);
+/// Writes rule tuples. Each distinct symbol is written as text once and afterwards as the
+/// index of that first time: a part's few dozen pieces name themselves hundreds of times, and
+/// two thirds of an entry were their names written out again.
+#[derive(Default)]
+pub struct Writer {
+    pub bytes: Vec<u8>,
+    seen: FxHashMap<Sym, u32>,
+}
+
+/// Value tags.
+const NUMBER: u8 = 0;
+const UNSIGNED: u8 = 1;
+const FLOAT: u8 = 2;
+const SYMBOL: u8 = 3;
+const VEC3: u8 = 4;
+const ISO: u8 = 5;
+const BOX: u8 = 6;
+/// A symbol written before: the u32 index of its first writing.
+const SYMBOL_AGAIN: u8 = 7;
+
+impl Writer {
+    /// A writer appending to `bytes`.
+    pub fn new(bytes: Vec<u8>) -> Writer {
+        Writer {
+            bytes,
+            seen: FxHashMap::default(),
+        }
     }
-}
 
-/// Appends tuples: count, then each tuple.
-pub fn put_tuples(out: &mut Vec<u8>, tuples: &[Vec<Value>]) {
-    put_u64(out, tuples.len() as u64);
-    for t in tuples {
-        put_tuple(out, t);
-    }
-}
-
-/// Appends one tuple: its arity and values.
-pub fn put_tuple(out: &mut Vec<u8>, t: &[Value]) {
-    put_u64(out, t.len() as u64);
-    for v in t {
-        put_value(out, v);
-    }
-}
-
-pub fn put_u64(out: &mut Vec<u8>, n: u64) {
-    out.extend_from_slice(&n.to_le_bytes());
-}
-
-pub fn put_f64(out: &mut Vec<u8>, x: f64) {
-    put_u64(out, x.to_bits());
-}
-
-pub fn put_str(out: &mut Vec<u8>, s: &str) {
-    put_u64(out, s.len() as u64);
-    out.extend_from_slice(s.as_bytes());
-}
-
-fn put_iso(out: &mut Vec<u8>, pose: &Isometry3<f64>) {
-    let t = pose.translation.vector;
-    let q = pose.rotation.quaternion();
-    for x in [t.x, t.y, t.z, q.w, q.i, q.j, q.k] {
-        put_f64(out, x);
-    }
-}
-
-pub fn put_value(out: &mut Vec<u8>, v: &Value) {
-    match v {
-        Value::Number(n) => {
-            out.push(0);
-            put_u64(out, *n as u64);
-        }
-        Value::Unsigned(n) => {
-            out.push(1);
-            put_u64(out, *n);
-        }
-        Value::Float(x) => {
-            out.push(2);
-            put_f64(out, x.0);
-        }
-        Value::Symbol(s) => {
-            out.push(3);
-            put_str(out, s);
-        }
-        Value::Vec3(v) => {
-            out.push(4);
-            for x in v.0.iter() {
-                put_f64(out, *x);
-            }
-        }
-        Value::Iso(i) => {
-            out.push(5);
-            put_iso(out, &i.0);
-        }
-        Value::Box(b) => {
-            out.push(6);
-            put_iso(out, &b.pose);
-            for x in b.half.iter() {
-                put_f64(out, *x);
+    /// A relation set: count, then each relation's name, tuple count and tuples.
+    pub fn relations(&mut self, relations: &Relations) {
+        self.u64(relations.len() as u64);
+        for (name, tuples) in relations {
+            self.str(name);
+            self.u64(tuples.len() as u64);
+            for t in tuples {
+                self.tuple(t);
             }
         }
     }
+
+    /// One tuple: its arity and values.
+    pub fn tuple(&mut self, t: &[Value]) {
+        self.u64(t.len() as u64);
+        for v in t {
+            self.value(v);
+        }
+    }
+
+    pub fn u64(&mut self, n: u64) {
+        self.bytes.extend_from_slice(&n.to_le_bytes());
+    }
+
+    fn f64(&mut self, x: f64) {
+        self.u64(x.to_bits());
+    }
+
+    pub fn str(&mut self, s: &str) {
+        self.u64(s.len() as u64);
+        self.bytes.extend_from_slice(s.as_bytes());
+    }
+
+    fn iso(&mut self, pose: &Isometry3<f64>) {
+        let t = pose.translation.vector;
+        let q = pose.rotation.quaternion();
+        for x in [t.x, t.y, t.z, q.w, q.i, q.j, q.k] {
+            self.f64(x);
+        }
+    }
+
+    pub fn value(&mut self, v: &Value) {
+        match v {
+            Value::Number(n) => {
+                self.bytes.push(NUMBER);
+                self.u64(*n as u64);
+            }
+            Value::Unsigned(n) => {
+                self.bytes.push(UNSIGNED);
+                self.u64(*n);
+            }
+            Value::Float(x) => {
+                self.bytes.push(FLOAT);
+                self.f64(x.0);
+            }
+            Value::Symbol(s) => {
+                let next = self.seen.len() as u32;
+                match self.seen.entry(*s) {
+                    Entry::Occupied(first) => {
+                        self.bytes.push(SYMBOL_AGAIN);
+                        self.bytes.extend_from_slice(&first.get().to_le_bytes());
+                    }
+                    Entry::Vacant(slot) => {
+                        slot.insert(next);
+                        self.bytes.push(SYMBOL);
+                        self.str(s);
+                    }
+                }
+            }
+            Value::Vec3(v) => {
+                self.bytes.push(VEC3);
+                for x in v.0.iter() {
+                    self.f64(*x);
+                }
+            }
+            Value::Iso(i) => {
+                self.bytes.push(ISO);
+                self.iso(&i.0);
+            }
+            Value::Box(b) => {
+                self.bytes.push(BOX);
+                self.iso(&b.pose);
+                for x in b.half.iter() {
+                    self.f64(*x);
+                }
+            }
+        }
+    }
 }
 
-/// Reads what the `put_` functions wrote; every read fails softly (None) on short or
-/// malformed input.
+/// Reads what a `Writer` wrote; every read fails softly (None) on short or malformed input.
 pub struct Reader<'a> {
     bytes: &'a [u8],
+    /// The symbols read so far, in order: what `SYMBOL_AGAIN` refers to.
+    seen: Vec<Sym>,
 }
 
 impl<'a> Reader<'a> {
     pub fn new(bytes: &'a [u8]) -> Self {
-        Reader { bytes }
+        Reader {
+            bytes,
+            seen: Vec::new(),
+        }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -149,13 +190,21 @@ impl<'a> Reader<'a> {
     pub fn value(&mut self) -> Option<Value> {
         let tag = *self.take(1)?.first()?;
         Some(match tag {
-            0 => Value::Number(self.u64()? as i64),
-            1 => Value::Unsigned(self.u64()?),
-            2 => Value::Float(F64(self.f64()?)),
-            3 => Value::sym(self.str()?),
-            4 => Value::Vec3(Vec3::new(self.f64()?, self.f64()?, self.f64()?)),
-            5 => Value::Iso(Arc::new(Iso(self.iso()?))),
-            6 => {
+            NUMBER => Value::Number(self.u64()? as i64),
+            UNSIGNED => Value::Unsigned(self.u64()?),
+            FLOAT => Value::Float(F64(self.f64()?)),
+            SYMBOL => {
+                let s = Sym::from(self.str()?);
+                self.seen.push(s);
+                Value::Symbol(s)
+            }
+            SYMBOL_AGAIN => {
+                let index = u32::from_le_bytes(self.take(4)?.try_into().ok()?);
+                Value::Symbol(*self.seen.get(index as usize)?)
+            }
+            VEC3 => Value::Vec3(Vec3::new(self.f64()?, self.f64()?, self.f64()?)),
+            ISO => Value::Iso(Arc::new(Iso(self.iso()?))),
+            BOX => {
                 let pose = self.iso()?;
                 let half = Vector3::new(self.f64()?, self.f64()?, self.f64()?);
                 Value::Box(Arc::new(OBox { pose, half }))
@@ -168,7 +217,8 @@ impl<'a> Reader<'a> {
         let n = self.count(8)?;
         let mut tuples = Vec::with_capacity(n);
         for _ in 0..n {
-            let arity = self.count(9)?;
+            // The shortest value is a symbol written before: its tag and index.
+            let arity = self.count(5)?;
             let mut t = Vec::with_capacity(arity);
             for _ in 0..arity {
                 t.push(self.value()?);
@@ -215,8 +265,9 @@ mod tests {
         let mut relations = Relations::new();
         relations.insert("r".into(), vec![tuple.clone(), vec![]]);
         relations.insert("empty".into(), vec![]);
-        let mut bytes = Vec::new();
-        put_relations(&mut bytes, &relations);
+        let mut w = Writer::default();
+        w.relations(&relations);
+        let bytes = w.bytes;
         let back = Reader::new(&bytes).relations().unwrap();
         assert_eq!(back, relations);
         // Equality of F64 is by bits, so -0.0 and the subnormal survived exactly.
@@ -224,5 +275,37 @@ mod tests {
             let mut r = Reader::new(&bytes[..cut]);
             assert!(r.relations().is_none(), "cut at {cut}");
         }
+    }
+
+    #[test]
+    fn a_repeated_symbol_is_written_once_and_a_reference_to_none_fails() {
+        let name = "2O2Fr$t4X7Zf8NOew3FLOH";
+        let tuples = vec![
+            vec![Value::sym(name), Value::sym("stud")],
+            vec![Value::sym("stud"), Value::sym(name), Value::sym(name)],
+        ];
+        let mut relations = Relations::new();
+        relations.insert("r".into(), tuples);
+        let mut w = Writer::default();
+        w.relations(&relations);
+        let bytes = w.bytes;
+        let text = |t: &str| {
+            bytes
+                .windows(t.len())
+                .filter(|x| *x == t.as_bytes())
+                .count()
+        };
+        assert_eq!((text(name), text("stud")), (1, 1));
+        assert_eq!(Reader::new(&bytes).relations().unwrap(), relations);
+
+        // One tuple holding a reference to symbol 5, of which none was read.
+        let mut w = Writer::default();
+        w.u64(1);
+        w.str("r");
+        w.u64(1);
+        w.u64(1);
+        w.bytes.push(SYMBOL_AGAIN);
+        w.bytes.extend_from_slice(&5u32.to_le_bytes());
+        assert!(Reader::new(&w.bytes).relations().is_none());
     }
 }
