@@ -14,7 +14,7 @@
 //! time only the current path; `PLAN_SCALE_SIZES=1` also prints the largest relations).
 //! Peak memory: `/usr/bin/time -v framewright plan --json M.ifc`.
 
-use framewright::cache::{Cache, reason_plan_cached};
+use framewright::cache::{Cache, reason_plan_cached_with};
 use framewright::cell::Cell;
 use framewright::frame::placement::{SearchOptions, add_placement_facts_with, reason_placed};
 use framewright::frame::plan::Plan;
@@ -40,8 +40,19 @@ enum Reasoning {
     TwoPasses(SearchOptions),
 }
 
-/// Runs `plan --json` on `path`, printing each phase; returns the total seconds and the JSON.
-fn plan(path: &Path, reasoning: &Reasoning, label: &str) -> (f64, Vec<u8>) {
+/// The report's JSON as `plan --json` writes it (through a buffer), hashed as it is written:
+/// a growing buffer of the whole document would cost reallocations `plan` does not pay.
+fn json_digest(report: &PlanReport) -> blake3::Hash {
+    let mut hasher = blake3::Hasher::new();
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, &mut hasher);
+    report.write_json(&mut out).expect("json");
+    drop(out);
+    hasher.finalize()
+}
+
+/// Runs `plan --json` on `path`, printing each phase; returns the total seconds and the
+/// JSON's digest.
+fn plan(path: &Path, reasoning: &Reasoning, label: &str) -> (f64, blake3::Hash) {
     let start = Instant::now();
     let mut last = start;
     let mut lap = |what: &str| {
@@ -94,25 +105,26 @@ fn plan(path: &Path, reasoning: &Reasoning, label: &str) -> (f64, Vec<u8>) {
     }
     let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
     lap("typed plan");
-    let mut json = Vec::new();
-    report.write_json(&mut json).expect("json");
+    let json = json_digest(&report);
     lap("JSON");
     (start.elapsed().as_secs_f64(), json)
 }
 
 /// Runs `plan --json` through the cache folder `cache` (the reasoning per part, stored and
-/// read back); returns the total seconds and the JSON without the `cache` block.
-fn plan_cached(path: &Path, cache: &Cache, label: &str) -> (f64, Vec<u8>) {
+/// read back), the plan built beside a first run's storing as `plan` does; returns the total
+/// seconds and the digest of the JSON without the `cache` block.
+fn plan_cached(path: &Path, cache: &Cache, label: &str) -> (f64, blake3::Hash) {
     let start = Instant::now();
     let model = Model::open(path).expect("read");
     let cell = Cell::load("study-abb").expect("cell");
     let mut facts = model_facts(&model, &Default::default());
     facts.extend(cell_facts(&cell));
     let limits = RuleLimits::from_env().expect("limits");
-    let (reasoned, counts) = reason_plan_cached(facts, &cell, cache, &limits).expect("reason");
-    let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
-    let mut json = Vec::new();
-    report.write_json(&mut json).expect("json");
+    let (_reasoned, counts, plan) = reason_plan_cached_with(facts, &cell, cache, &limits, |r| {
+        Plan::from_relations(&model, r)
+    })
+    .expect("reason");
+    let json = json_digest(&PlanReport::new(&model, &plan));
     let seconds = start.elapsed().as_secs_f64();
     eprintln!(
         "  {label} walls reasoned {}, from the cache {}",
