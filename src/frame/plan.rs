@@ -250,7 +250,8 @@ impl Plan {
             .iter()
             .map(|w| (w.key.as_str(), w.id.as_str()))
             .collect();
-        let wall_of = wall_of_piece
+        // From the relation's rows, which come sorted by piece: the map is built without sorting.
+        let wall_of = wall_pairs
             .iter()
             .map(|(p, w)| (p.to_string(), wall_ids.get(w).unwrap_or(w).to_string()))
             .collect();
