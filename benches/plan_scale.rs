@@ -141,19 +141,12 @@ fn main() {
         .and_then(|i| args.get(i + 1)?.parse().ok())
         .unwrap_or(5);
     let skip_old = args.iter().any(|a| a == "--skip-old");
-    let spec = BlockSpec {
-        unit: framewright::synth::building::BuildingSpec {
-            length: feet(24.0),
-            depth: feet(14.0),
-            ..models::default_building_spec()
-        },
-        blocks: 3,
-        storeys,
-        rows: 3,
-        cols: 9,
-        gap: 3.0,
-        floor_depth: 0.3,
+    let unit = framewright::synth::building::BuildingSpec {
+        length: feet(24.0),
+        depth: feet(14.0),
+        ..models::default_building_spec()
     };
+    let spec = BlockSpec::new(unit, 3, storeys, 3, 9);
     let layout = blocks(&spec, "plan_scale").expect("layout");
     let written = write_ifc(
         &layout,

@@ -96,15 +96,7 @@ fn the_test_models_plan_as_before() {
 #[test]
 fn a_generated_block_plans_as_before() {
     // One block of two storeys of 1 x 2 units: grouped walls with doors and windows.
-    let spec = BlockSpec {
-        unit: models::default_building_spec(),
-        blocks: 1,
-        storeys: 2,
-        rows: 1,
-        cols: 2,
-        gap: 3.0,
-        floor_depth: 0.3,
-    };
+    let spec = BlockSpec::new(models::default_building_spec(), 1, 2, 1, 2);
     let layout = blocks(&spec, "selected").expect("layout");
     let written = write_ifc(
         &layout,

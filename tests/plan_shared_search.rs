@@ -29,15 +29,7 @@ fn plan_json(model: &Model, cell: &Cell, share: bool) -> Vec<u8> {
 #[test]
 fn shared_search_gives_the_plan_of_one_search_per_target() {
     // Two storeys of two identical units: every wall has three copies elsewhere.
-    let spec = BlockSpec {
-        unit: models::default_building_spec(),
-        blocks: 1,
-        storeys: 2,
-        rows: 1,
-        cols: 2,
-        gap: 3.0,
-        floor_depth: 0.3,
-    };
+    let spec = BlockSpec::new(models::default_building_spec(), 1, 2, 1, 2);
     let layout = blocks(&spec, "shared").expect("layout");
     let written = write_ifc(
         &layout,

@@ -7,15 +7,7 @@ use framewright::synth::{Grouping, WriteOptions, models, write_ifc};
 use std::collections::BTreeMap;
 
 fn spec() -> BlockSpec {
-    BlockSpec {
-        unit: models::default_building_spec(),
-        blocks: 2,
-        storeys: 3,
-        rows: 1,
-        cols: 2,
-        gap: 3.0,
-        floor_depth: 0.3,
-    }
+    BlockSpec::new(models::default_building_spec(), 2, 3, 1, 2)
 }
 
 fn count(text: &str, entity: &str) -> usize {

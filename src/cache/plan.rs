@@ -681,15 +681,7 @@ mod tests {
     fn small_block() -> Model {
         use crate::synth::building::{BlockSpec, blocks};
         use crate::synth::{Grouping, WriteOptions, models, write_ifc};
-        let spec = BlockSpec {
-            unit: models::default_building_spec(),
-            blocks: 1,
-            storeys: 2,
-            rows: 1,
-            cols: 2,
-            gap: 3.0,
-            floor_depth: 0.3,
-        };
+        let spec = BlockSpec::new(models::default_building_spec(), 1, 2, 1, 2);
         let layout = blocks(&spec, "small").unwrap();
         let written = write_ifc(
             &layout,

@@ -1,6 +1,8 @@
 //! `framewright synth MODEL`: write a generated wood-frame IFC model (and its truth sidecar).
 use super::{CmdResult, Failure, print_stdout};
-use framewright::synth::building::{BlockSpec, BuildingSpec, frame_building, grid};
+use framewright::synth::building::{
+    BlockSpec, BuildingSpec, DEFAULT_FLOOR_DEPTH, DEFAULT_GAP, frame_building, grid,
+};
 use framewright::synth::layout::{Layout, Vec3};
 use framewright::synth::models;
 use framewright::synth::units::{Lumber, parse_length};
@@ -349,8 +351,6 @@ fn building_spec(args: &SynthArgs, size: Option<(f64, f64)>) -> Result<BuildingS
 /// 1,620 walls, 49,410 members (about 46 MB with --grouping wall --psets --openings).
 const BLOCK_DEFAULTS: (usize, usize, (usize, usize)) = (3, 5, (3, 9));
 const BLOCK_UNIT_FEET: (f64, f64) = (24.0, 14.0);
-/// Depth of the floor structure between storeys, metres.
-const FLOOR_DEPTH: f64 = 0.3;
 
 fn block_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
     let (blocks, storeys, grid) = BLOCK_DEFAULTS;
@@ -370,8 +370,8 @@ fn block_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
         storeys: args.storeys.unwrap_or(storeys),
         rows,
         cols,
-        gap: opt_length(&args.gap, 3.0)?,
-        floor_depth: FLOOR_DEPTH,
+        gap: opt_length(&args.gap, DEFAULT_GAP)?,
+        floor_depth: DEFAULT_FLOOR_DEPTH,
     };
     framewright::synth::building::blocks(
         &spec,
@@ -396,7 +396,7 @@ fn building_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
                 &spec,
                 rows,
                 cols,
-                opt_length(&args.gap, 3.0)?,
+                opt_length(&args.gap, DEFAULT_GAP)?,
                 &format!("building_grid_{rows}x{cols}"),
             )
         }

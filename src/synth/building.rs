@@ -144,6 +144,33 @@ pub struct BlockSpec {
     pub floor_depth: f64,
 }
 
+/// Space between neighbouring units and blocks when none is given, metres.
+pub const DEFAULT_GAP: f64 = 3.0;
+/// Depth of the floor structure between storeys when none is given, metres.
+pub const DEFAULT_FLOOR_DEPTH: f64 = 0.3;
+
+impl BlockSpec {
+    /// `blocks` blocks of `storeys` storeys of `rows` x `cols` units of `unit`, the default gap
+    /// and floor depth apart (what `synth block` gives without `--gap`).
+    pub fn new(
+        unit: BuildingSpec,
+        blocks: usize,
+        storeys: usize,
+        rows: usize,
+        cols: usize,
+    ) -> Self {
+        BlockSpec {
+            unit,
+            blocks,
+            storeys,
+            rows,
+            cols,
+            gap: DEFAULT_GAP,
+            floor_depth: DEFAULT_FLOOR_DEPTH,
+        }
+    }
+}
+
 /// Refuse block models with more than this many storeys in all (about 10^6 members at 10,000 units).
 pub const MAX_STOREYS: usize = 1_000;
 
