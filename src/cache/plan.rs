@@ -479,9 +479,7 @@ fn part_key(base: &blake3::Hasher, partition: &Partition, facts: &Facts, i: usiz
 fn write_named<T: AsRef<[Value]>>(w: &mut Writer, named: &[(&str, Vec<T>)]) {
     w.u64(named.len() as u64);
     for (name, rows) in named {
-        w.str(name);
-        w.u64(rows.len() as u64);
-        rows.iter().for_each(|t| w.tuple(t.as_ref()));
+        w.relation(name, rows.iter().map(AsRef::as_ref));
     }
 }
 
@@ -503,11 +501,10 @@ fn encode_share(key: &str, out: &Relations, share: &[(usize, usize)]) -> Vec<u8>
         while next < share.len() && share[next].0 == slot {
             next += 1;
         }
-        w.str(name);
-        w.u64((next - start) as u64);
-        for &(_, row) in &share[start..next] {
-            w.tuple(&rows[row]);
-        }
+        let tuples = share[start..next]
+            .iter()
+            .map(|&(_, row)| rows[row].as_slice());
+        w.relation(name, tuples);
     }
     seal(w.bytes)
 }

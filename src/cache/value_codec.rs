@@ -1,6 +1,6 @@
 //! Rule tuples as bytes and back, exactly: floats as their bits, a symbol as UTF-8 with its
-//! length the first time and as a back-reference after. The same bytes feed the plan cache's keys (what a part's rules read) and its
-//! entries (what they derived).
+//! length the first time and as a back-reference after. The same bytes feed the plan cache's
+//! keys (what a part's rules read) and its entries (what they derived).
 
 use crate::logic::Value;
 use crate::logic::compiled::Relations;
@@ -39,15 +39,20 @@ impl Writer {
         }
     }
 
-    /// A relation set: count, then each relation's name, tuple count and tuples.
+    /// A relation set: count, then each relation as `relation` writes it.
     pub fn relations(&mut self, relations: &Relations) {
         self.u64(relations.len() as u64);
         for (name, tuples) in relations {
-            self.str(name);
-            self.u64(tuples.len() as u64);
-            for t in tuples {
-                self.tuple(t);
-            }
+            self.relation(name, tuples.iter().map(Vec::as_slice));
+        }
+    }
+
+    /// One relation of a set: its name, tuple count and tuples.
+    pub fn relation<'t>(&mut self, name: &str, tuples: impl ExactSizeIterator<Item = &'t [Value]>) {
+        self.str(name);
+        self.u64(tuples.len() as u64);
+        for t in tuples {
+            self.tuple(t);
         }
     }
 
