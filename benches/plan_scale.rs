@@ -103,7 +103,8 @@ fn plan(path: &Path, reasoning: &Reasoning, label: &str) -> (f64, blake3::Hash) 
             eprintln!("    {name} {n}");
         }
     }
-    let report = PlanReport::new(&model, &Plan::from_reasoned(&model, &reasoned));
+    let plan = Plan::from_reasoned(&model, &reasoned);
+    let report = PlanReport::new(&model, &plan);
     lap("typed plan");
     let json = json_digest(&report);
     lap("JSON");

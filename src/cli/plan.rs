@@ -58,7 +58,8 @@ pub fn run(args: PlanArgs) -> CmdResult {
     } else {
         print_stdout(&report.to_text())
     };
-    leave_to_exit((model, reasoned, plan, report));
+    leave_to_exit(report);
+    leave_to_exit((model, reasoned, plan));
     // After the output: the cache's entries are written meanwhile.
     warn_if_unwritable(cache.as_ref());
     written

@@ -4,16 +4,18 @@
 use super::{round_m, round_point};
 use crate::frame::plan::Plan;
 use crate::ifc::{LengthUnit, Model};
+use rustc_hash::FxHashMap;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
+/// Borrows the model's and the plan's text: a 50,000-member report copies no name.
 #[derive(Debug, Serialize)]
-pub struct PlanReport {
+pub struct PlanReport<'a> {
     pub schema: String,
     pub length_unit: LengthUnit,
-    pub members: Vec<MemberRow>,
-    pub walls: Vec<WallRow>,
+    pub members: Vec<MemberRow<'a>>,
+    pub walls: Vec<WallRow<'a>>,
     pub warnings: Vec<String>,
     /// Walls reasoned and walls read from the cache (absent without a cache).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -21,15 +23,15 @@ pub struct PlanReport {
 }
 
 #[derive(Debug, Serialize)]
-pub struct MemberRow {
-    pub id: String,
+pub struct MemberRow<'a> {
+    pub id: &'a str,
     pub entity: u64,
-    pub global_id: String,
+    pub global_id: &'a str,
     pub piece: Option<usize>,
-    pub name: Option<String>,
-    pub ifc_type: String,
-    pub wall_id: Option<String>,
-    pub role: Option<String>,
+    pub name: Option<&'a str>,
+    pub ifc_type: &'a str,
+    pub wall_id: Option<&'a str>,
+    pub role: Option<&'a str>,
     pub axis_start: [f64; 3],
     pub axis_end: [f64; 3],
     pub width: f64,
@@ -39,35 +41,35 @@ pub struct MemberRow {
 }
 
 #[derive(Debug, Serialize)]
-pub struct WallRow {
-    pub wall_id: String,
-    pub name: String,
-    pub group_global_id: Option<String>,
-    pub member_ids: Vec<String>,
+pub struct WallRow<'a> {
+    pub wall_id: &'a str,
+    pub name: &'a str,
+    pub group_global_id: Option<&'a str>,
+    pub member_ids: &'a [String],
     /// 4×4 row-major; columns u, v, w, origin in world coordinates.
     pub frame_matrix: [[f64; 4]; 4],
     pub length: f64,
     pub height: f64,
     pub thickness: f64,
-    pub role_counts: BTreeMap<String, usize>,
-    pub assembly_order: Vec<String>,
-    pub precedence: Vec<PrecedenceRow>,
-    pub nailing_targets: Vec<NailRow>,
-    pub framing_targets: Vec<FramingRow>,
+    pub role_counts: BTreeMap<&'a str, usize>,
+    pub assembly_order: &'a [String],
+    pub precedence: Vec<PrecedenceRow<'a>>,
+    pub nailing_targets: Vec<NailRow<'a>>,
+    pub framing_targets: Vec<FramingRow<'a>>,
 }
 
 #[derive(Debug, Serialize)]
-pub struct PrecedenceRow {
-    pub before: String,
-    pub after: String,
-    pub reason: String,
+pub struct PrecedenceRow<'a> {
+    pub before: &'a str,
+    pub after: &'a str,
+    pub reason: &'a str,
 }
 
 #[derive(Debug, Serialize)]
-pub struct NailRow {
-    pub plate: String,
-    pub member: String,
-    pub kind: String,
+pub struct NailRow<'a> {
+    pub plate: &'a str,
+    pub member: &'a str,
+    pub kind: &'a str,
     pub u: f64,
     pub v: f64,
     pub w: f64,
@@ -76,8 +78,8 @@ pub struct NailRow {
 }
 
 #[derive(Debug, Serialize)]
-pub struct FramingRow {
-    pub member: String,
+pub struct FramingRow<'a> {
+    pub member: &'a str,
     /// Centre of mass in the robot base frame, metres.
     pub position: [f64; 3],
     /// Orientation in the robot base frame, quaternion w, x, y, z.
@@ -89,44 +91,86 @@ fn unit(x: f64) -> f64 {
     if r == 0.0 { 0.0 } else { r }
 }
 
-impl PlanReport {
-    pub fn new(model: &Model, plan: &Plan) -> PlanReport {
+/// What the plan says of each piece of the model, by its index: wall, role, mass.
+struct PieceLookup<'a> {
+    wall_of: Vec<Option<&'a str>>,
+    role: Vec<Option<&'a str>>,
+    mass: Vec<f64>,
+}
+
+impl<'a> PieceLookup<'a> {
+    /// One pass over each of the plan's maps (sorted by piece id, so looking every piece up
+    /// in them would compare long ids over and over).
+    fn new(model: &Model, plan: &'a Plan) -> Self {
+        let index: FxHashMap<&str, usize> = model
+            .pieces()
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.id.as_str(), i))
+            .collect();
+        let n = model.pieces().len();
+        let by_piece = |map: &'a BTreeMap<String, String>| {
+            let mut out = vec![None; n];
+            for (id, value) in map {
+                if let Some(&i) = index.get(id.as_str()) {
+                    out[i] = Some(value.as_str());
+                }
+            }
+            out
+        };
+        let mut mass = vec![0.0; n];
+        for (id, kg) in &plan.masses {
+            if let Some(&i) = index.get(id.as_str()) {
+                mass[i] = *kg;
+            }
+        }
+        PieceLookup {
+            wall_of: by_piece(&plan.wall_of),
+            role: by_piece(&plan.roles),
+            mass,
+        }
+    }
+}
+
+impl<'a> PlanReport<'a> {
+    pub fn new(model: &'a Model, plan: &'a Plan) -> PlanReport<'a> {
         use rayon::prelude::*;
-        let frames: BTreeMap<&str, &nalgebra::Isometry3<f64>> = plan
+        // World → wall coordinates, once per wall.
+        let to_wall: FxHashMap<&str, nalgebra::Isometry3<f64>> = plan
             .walls
             .iter()
-            .map(|w| (w.id.as_str(), &w.frame))
+            .map(|w| (w.id.as_str(), w.frame.inverse()))
             .collect();
+        let lookup = PieceLookup::new(model, plan);
         let members = model
             .pieces()
             .par_iter()
-            .map(|p| {
-                let wall_id = plan.wall_of.get(&p.id).cloned();
+            .enumerate()
+            .map(|(i, p)| {
+                let wall_id = lookup.wall_of[i];
                 let (mut start, mut end) = p.axis();
                 // Horizontal members of a wall run from their smaller-u end.
-                if let Some(frame) = wall_id.as_deref().and_then(|w| frames.get(w)) {
+                if let Some(to_wall) = wall_id.and_then(|w| to_wall.get(w)) {
                     let d = end - start;
-                    if d.z.abs() <= d.xy().norm()
-                        && (frame.inverse() * start).x > (frame.inverse() * end).x
-                    {
+                    if d.z.abs() <= d.xy().norm() && (to_wall * start).x > (to_wall * end).x {
                         std::mem::swap(&mut start, &mut end);
                     }
                 }
                 MemberRow {
-                    id: p.id.clone(),
+                    id: &p.id,
                     entity: p.entity,
-                    global_id: p.global_id.clone(),
+                    global_id: &p.global_id,
                     piece: p.piece,
-                    name: p.name.clone(),
-                    ifc_type: p.ifc_type.clone(),
-                    role: plan.roles.get(&p.id).cloned(),
+                    name: p.name.as_deref(),
+                    ifc_type: &p.ifc_type,
+                    role: lookup.role[i],
                     wall_id,
                     axis_start: round_point(&start),
                     axis_end: round_point(&end),
                     width: round_m(p.obox.width()),
                     thickness: round_m(p.obox.thickness()),
                     length: round_m(p.obox.length()),
-                    mass: (plan.masses.get(&p.id).copied().unwrap_or(0.0) * 1e6).round() / 1e6,
+                    mass: (lookup.mass[i] * 1e6).round() / 1e6,
                 }
             })
             .collect();
@@ -146,42 +190,36 @@ impl PlanReport {
                 });
                 let mut role_counts = BTreeMap::new();
                 for p in &w.members {
-                    *role_counts
-                        .entry(
-                            plan.roles
-                                .get(p)
-                                .cloned()
-                                .unwrap_or_else(|| "unclassified".into()),
-                        )
-                        .or_insert(0) += 1;
+                    let role = plan.roles.get(p).map_or("unclassified", String::as_str);
+                    *role_counts.entry(role).or_insert(0) += 1;
                 }
                 WallRow {
-                    wall_id: w.id.clone(),
-                    name: w.name.clone(),
-                    group_global_id: w.group_global_id.clone(),
-                    member_ids: w.members.clone(),
+                    wall_id: &w.id,
+                    name: &w.name,
+                    group_global_id: w.group_global_id.as_deref(),
+                    member_ids: &w.members,
                     frame_matrix,
                     length: round_m(w.length),
                     height: round_m(w.height),
                     thickness: round_m(w.thickness),
                     role_counts,
-                    assembly_order: w.assembly_order.clone(),
+                    assembly_order: &w.assembly_order,
                     precedence: w
                         .precedence
                         .iter()
                         .map(|(b, a, r)| PrecedenceRow {
-                            before: b.clone(),
-                            after: a.clone(),
-                            reason: r.clone(),
+                            before: b,
+                            after: a,
+                            reason: r,
                         })
                         .collect(),
                     nailing_targets: w
                         .nailing_targets
                         .iter()
                         .map(|n| NailRow {
-                            plate: n.plate.clone(),
-                            member: n.member.clone(),
-                            kind: n.kind.clone(),
+                            plate: &n.plate,
+                            member: &n.member,
+                            kind: &n.kind,
                             u: round_m(n.u),
                             v: round_m(n.v),
                             w: round_m(n.w),
@@ -199,7 +237,7 @@ impl PlanReport {
                         .map(|(p, pose)| {
                             let q = pose.rotation.quaternion();
                             FramingRow {
-                                member: p.clone(),
+                                member: p,
                                 position: round_point(&nalgebra::Point3::from(
                                     pose.translation.vector,
                                 )),
