@@ -22,6 +22,7 @@ use crate::logic::{Origin, Value};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Spacing of the offsets tried (m).
@@ -173,7 +174,34 @@ pub(crate) struct SearchMemo {
 type Memo = Mutex<FxHashMap<[i64; 10], Shared>>;
 
 /// Reach runs of one search key, filled by whichever part searches the key first.
-type Shared = Arc<OnceLock<Vec<(f64, f64)>>>;
+type Shared = Arc<Slot>;
+
+/// One search key's result, and whether a thread has taken it on.
+#[derive(Default)]
+struct Slot {
+    taken: AtomicBool,
+    runs: OnceLock<Vec<(f64, f64)>>,
+}
+
+impl Slot {
+    /// Searches the key unless a thread has taken it on already.
+    fn search_unless_taken(&self, search: impl FnOnce() -> Vec<(f64, f64)>) {
+        if !self.taken.swap(true, Ordering::AcqRel) {
+            self.runs.get_or_init(search);
+        }
+    }
+
+    /// The result, once the thread that took the key on has it (a key is taken on only to
+    /// be searched at once, so this waits at most one search).
+    fn wait(&self) -> &Vec<(f64, f64)> {
+        loop {
+            if let Some(runs) = self.runs.get() {
+                return runs;
+            }
+            std::thread::sleep(std::time::Duration::from_micros(20));
+        }
+    }
+}
 
 /// Takes one placement fact: relation, tuple, and how to say where it came from.
 type AddFact<'a> = dyn FnMut(&'static str, Vec<Value>, &dyn Fn() -> String) + 'a;
@@ -389,13 +417,15 @@ fn search_each<T: Sync>(
             .map(|item| memo.entry(key(item)).or_default().clone())
             .collect()
     };
-    // A key another thread is searching waits for its result (the search runs no parallel
-    // work of its own, so waiting cannot deadlock).
-    let found: Vec<&Vec<(f64, f64)>> = unique
+    // Parts that reach the same keys at once share them out: each searches the keys no one
+    // has taken on yet, then waits for the rest. (Waiting on each key in turn would block a
+    // pool thread for the whole of the other part's search: the first storeys of a model
+    // reach the same keys together.)
+    unique
         .par_iter()
         .zip(&cells)
-        .map(|(item, cell)| cell.get_or_init(|| search(item)))
-        .collect();
+        .for_each(|(item, cell)| cell.search_unless_taken(|| search(item)));
+    let found: Vec<&Vec<(f64, f64)>> = cells.iter().map(|cell| cell.wait()).collect();
     slot.into_iter().map(|k| found[k].clone()).collect()
 }
 
@@ -515,6 +545,40 @@ fn solves_above_floor(cell: &Cell, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn parts_reaching_the_same_keys_at_once_search_each_key_once() {
+        use rayon::prelude::*;
+        use std::sync::atomic::AtomicUsize;
+        // Eight parts of 200 items over 50 keys, all at once, one memo.
+        let memo: Memo = Mutex::default();
+        let searched = AtomicUsize::new(0);
+        let items: Vec<i64> = (0..200).map(|i| (i * 7) % 50).collect();
+        let key = |item: &i64| {
+            let mut k = [0; 10];
+            k[0] = *item;
+            k
+        };
+        let search = |item: &i64| {
+            searched.fetch_add(1, Ordering::Relaxed);
+            std::thread::sleep(std::time::Duration::from_micros(200));
+            vec![(*item as f64, *item as f64 + 0.5)]
+        };
+        let results: Vec<Vec<Vec<(f64, f64)>>> = (0..8)
+            .into_par_iter()
+            .map(|_| search_each(&items, key, Some(&memo), search))
+            .collect();
+        assert_eq!(
+            searched.load(Ordering::Relaxed),
+            50,
+            "each key searched once"
+        );
+        let expected: Vec<Vec<(f64, f64)>> = items
+            .iter()
+            .map(|&i| vec![(i as f64, i as f64 + 0.5)])
+            .collect();
+        assert!(results.iter().all(|r| *r == expected));
+    }
 
     #[test]
     fn reached_offsets_come_as_robust_runs() {
