@@ -63,7 +63,7 @@ impl Facts {
             .iter()
             .map(|(name, tuples)| {
                 let mut v: Vec<Vec<Value>> = tuples.iter().map(|(t, _)| t.clone()).collect();
-                v.sort();
+                v.sort_unstable();
                 v.dedup();
                 (name.to_string(), v)
             })

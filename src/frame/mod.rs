@@ -250,7 +250,7 @@ pub(crate) fn reason_compiled_placing(
     }
     for tuples in merged.values_mut() {
         if tuples.len() <= SMALL_RELATION {
-            tuples.sort();
+            tuples.sort_unstable();
             tuples.dedup();
         }
     }

@@ -253,11 +253,11 @@ impl Partition {
                     .map(|&j| all[j as usize].0.clone())
                     .collect();
                 if *name == "piece_index" && indices == Indices::Renumbered {
-                    tuples.sort();
+                    tuples.sort_unstable();
                     tuples.dedup();
                     renumber(&mut tuples);
                 }
-                tuples.sort();
+                tuples.sort_unstable();
                 tuples.dedup();
                 (name.to_string(), tuples)
             })

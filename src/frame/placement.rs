@@ -230,7 +230,7 @@ pub(crate) fn placement_relations(
         },
     );
     for tuples in relations.values_mut() {
-        tuples.sort();
+        tuples.sort_unstable();
         tuples.dedup();
     }
     relations
