@@ -68,20 +68,23 @@ pub fn reason_plan_cached_with<T: Send>(
         .into_par_iter()
         .map(|i| part_key(&base, &partition, &facts, i))
         .collect();
-    let extents = Extents::of(&facts, &partition);
     let mut counts = CacheCounts::default();
     // Each part's relations (with its storey_reach rows), from the cache or computed.
-    let looked: Vec<Found> = keys
-        .par_iter()
-        .zip(&partition.parts)
-        .map(
-            |(key, part)| match cache.get_plan(key).map(|b| decode(key, &b)) {
-                Some(Some(r)) if extents.agree(part.container, &r) => Found::Hit(r),
-                Some(Some(_)) | None => Found::Miss,
-                Some(None) => Found::Rejected,
-            },
-        )
-        .collect();
+    let looked: Vec<Found> = if cache.may_hold_plans() {
+        let extents = Extents::of(&facts, &partition);
+        keys.par_iter()
+            .zip(&partition.parts)
+            .map(
+                |(key, part)| match cache.get_plan(key).map(|b| decode(key, &b)) {
+                    Some(Some(r)) if extents.agree(part.container, &r) => Found::Hit(r),
+                    Some(Some(_)) | None => Found::Miss,
+                    Some(None) => Found::Rejected,
+                },
+            )
+            .collect()
+    } else {
+        keys.iter().map(|_| Found::Miss).collect()
+    };
     let rejected: Vec<bool> = looked
         .iter()
         .map(|f| matches!(f, Found::Rejected))
@@ -418,7 +421,7 @@ fn merge(partition: &Partition, results: Vec<Option<Relations>>) -> Relations {
         .collect();
     ordered.par_iter_mut().for_each(|relations| {
         relations.par_iter_mut().for_each(|(_, rows)| {
-            rows.sort();
+            rows.sort_unstable();
             rows.dedup();
         })
     });
@@ -430,7 +433,7 @@ fn merge(partition: &Partition, results: Vec<Option<Relations>>) -> Relations {
     }
     for rows in merged.values_mut() {
         if rows.len() <= crate::frame::SMALL_RELATION {
-            rows.sort();
+            rows.sort_unstable();
             rows.dedup();
         }
     }

@@ -71,6 +71,14 @@ impl Cache {
         std::fs::read(self.shared.plan_path(key)).ok()
     }
 
+    /// Whether the folder may hold plan entries: false when it has no plan folder or an
+    /// empty one, so a first run need not look up each of its parts.
+    pub fn may_hold_plans(&self) -> bool {
+        self.wait_for_writes();
+        std::fs::read_dir(self.shared.dir.join(PLANS))
+            .is_ok_and(|mut entries| entries.next().is_some())
+    }
+
     /// Stores a plan part's entry, like `put_wall`.
     pub fn put_plan(&self, key: &str, bytes: &[u8]) {
         self.shared
@@ -347,4 +355,22 @@ fn entry_files(dir: &Path) -> std::io::Result<Vec<EntryFile>> {
     });
     files.sort_by(|a, b| a.path.cmp(&b.path));
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_folder_holds_plans_once_one_is_stored_or_being_stored() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let cache = Cache::new(dir.path().join("cache"));
+        assert!(!cache.may_hold_plans(), "no folder yet");
+        std::fs::create_dir_all(dir.path().join("cache").join(PLANS)).expect("plans folder");
+        assert!(!cache.may_hold_plans(), "an empty plans folder");
+        // Entries still being written behind count: the check waits for them.
+        cache.put_plans_behind(vec![("ab12".into(), b"entry".to_vec())]);
+        assert!(cache.may_hold_plans());
+        assert_eq!(cache.get_plan("ab12").as_deref(), Some(&b"entry"[..]));
+    }
 }
