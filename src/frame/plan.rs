@@ -147,9 +147,10 @@ impl Plan {
             let mut keys: Vec<&str> = get("wall").iter().map(|t| sym(&t[0])).collect();
             keys.sort_by_key(|k| file_order(k));
             // Members, precedence, nailing and framing targets bucketed by wall in one pass each.
-            let mut members: FxHashMap<&str, Vec<&str>> = FxHashMap::default();
+            // Each member with its place in the file, looked up once (not in every comparison).
+            let mut members: FxHashMap<&str, Vec<(usize, &str)>> = FxHashMap::default();
             for (p, w) in &wall_of_piece {
-                members.entry(w).or_default().push(p);
+                members.entry(w).or_default().push((file_order(p), p));
             }
             let mut precedence_by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
             for t in get("precedence") {
@@ -175,12 +176,17 @@ impl Plan {
                 .par_iter()
                 .enumerate()
                 .map(|(n, &key)| {
-                    let mut list = members.get(key).cloned().unwrap_or_default();
-                    list.sort_by_key(|p| (file_order(p), *p));
-                    let mut order = list.clone();
-                    order.sort_by_key(|p| {
-                        (ranks.get(p).copied().unwrap_or(i64::MAX), file_order(p))
-                    });
+                    // Sort keys are distinct for distinct pieces: unstable sorts give the
+                    // stable order.
+                    let mut placed = members.get(key).cloned().unwrap_or_default();
+                    placed.sort_unstable();
+                    let list: Vec<&str> = placed.iter().map(|(_, p)| *p).collect();
+                    let mut ranked: Vec<(i64, usize, &str)> = placed
+                        .iter()
+                        .map(|&(at, p)| (ranks.get(p).copied().unwrap_or(i64::MAX), at, p))
+                        .collect();
+                    ranked.sort_unstable();
+                    let order: Vec<&str> = ranked.iter().map(|(_, _, p)| *p).collect();
                     let mut precedence: Vec<(String, String, String)> = precedence_by
                         .get(key)
                         .into_iter()
