@@ -187,19 +187,38 @@ impl Slot {
     /// Searches the key unless a thread has taken it on already.
     fn search_unless_taken(&self, search: impl FnOnce() -> Vec<(f64, f64)>) {
         if !self.taken.swap(true, Ordering::AcqRel) {
-            self.runs.get_or_init(search);
+            self.fill(search);
         }
     }
 
     /// The result, once the thread that took the key on has it (a key is taken on only to
-    /// be searched at once, so this waits at most one search).
-    fn wait(&self) -> &Vec<(f64, f64)> {
+    /// be searched at once, so this waits at most one search); searched here if the key was
+    /// given back.
+    fn get(&self, search: impl FnOnce() -> Vec<(f64, f64)>) -> &Vec<(f64, f64)> {
         loop {
             if let Some(runs) = self.runs.get() {
                 return runs;
             }
+            if !self.taken.swap(true, Ordering::AcqRel) {
+                return self.fill(search);
+            }
             std::thread::sleep(std::time::Duration::from_micros(20));
         }
+    }
+
+    /// Searches the key this thread has taken on. A search that panics gives the key back,
+    /// so no other thread waits for it forever.
+    fn fill(&self, search: impl FnOnce() -> Vec<(f64, f64)>) -> &Vec<(f64, f64)> {
+        struct GiveBack<'a>(&'a AtomicBool);
+        impl Drop for GiveBack<'_> {
+            fn drop(&mut self) {
+                self.0.store(false, Ordering::Release);
+            }
+        }
+        let give_back = GiveBack(&self.taken);
+        let runs = self.runs.get_or_init(search);
+        std::mem::forget(give_back);
+        runs
     }
 }
 
@@ -425,7 +444,11 @@ fn search_each<T: Sync>(
         .par_iter()
         .zip(&cells)
         .for_each(|(item, cell)| cell.search_unless_taken(|| search(item)));
-    let found: Vec<&Vec<(f64, f64)>> = cells.iter().map(|cell| cell.wait()).collect();
+    let found: Vec<&Vec<(f64, f64)>> = unique
+        .iter()
+        .zip(&cells)
+        .map(|(item, cell)| cell.get(|| search(item)))
+        .collect();
     slot.into_iter().map(|k| found[k].clone()).collect()
 }
 
@@ -578,6 +601,34 @@ mod tests {
             .map(|&i| vec![(i as f64, i as f64 + 0.5)])
             .collect();
         assert!(results.iter().all(|r| *r == expected));
+    }
+
+    #[test]
+    fn a_search_that_panics_leaves_no_part_waiting_for_its_key() {
+        let memo: Memo = Mutex::default();
+        let key = |item: &i64| {
+            let mut k = [0; 10];
+            k[0] = *item;
+            k
+        };
+        let panicked = std::panic::catch_unwind(|| {
+            search_each(&[1, 2, 3], key, Some(&memo), |item: &i64| {
+                assert!(*item != 2, "a search that fails");
+                vec![(0.0, 1.0)]
+            })
+        });
+        assert!(panicked.is_err());
+        // Another part reaching the same keys searches the one given back (on a thread of
+        // its own, so a wait that never ends fails the test instead of hanging it).
+        let (done, result) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let runs = search_each(&[1, 2, 3], key, Some(&memo), |_: &i64| vec![(0.0, 2.0)]);
+            let _ = done.send(runs);
+        });
+        let runs = result
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("the key given back is searched, not waited for");
+        assert_eq!(runs[1], vec![(0.0, 2.0)]);
     }
 
     #[test]
