@@ -95,12 +95,7 @@ impl Plan {
         use rayon::prelude::*;
         let get = |relation: &str| relations.get(relation).map_or(&[][..], Vec::as_slice);
         // Lookups borrow the relations' symbols; only what the plan keeps is copied.
-        let index: FxHashMap<&str, usize> = model
-            .pieces()
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (p.id.as_str(), i))
-            .collect();
+        let index = model.piece_positions();
         let file_order = |p: &str| index.get(p).copied().unwrap_or(usize::MAX);
         let pairs = |relation: &str| -> Vec<(&str, &str)> {
             get(relation)

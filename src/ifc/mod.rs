@@ -119,6 +119,15 @@ impl Model {
         &self.pieces
     }
 
+    /// Each piece's index in `pieces()`, by piece id.
+    pub fn piece_positions(&self) -> rustc_hash::FxHashMap<&str, usize> {
+        self.pieces
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.id.as_str(), i))
+            .collect()
+    }
+
     pub fn header(&self) -> &Header {
         &self.file.header
     }

@@ -102,12 +102,7 @@ impl<'a> PieceLookup<'a> {
     /// One pass over each of the plan's maps (sorted by piece id, so looking every piece up
     /// in them would compare long ids over and over).
     fn new(model: &Model, plan: &'a Plan) -> Self {
-        let index: FxHashMap<&str, usize> = model
-            .pieces()
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (p.id.as_str(), i))
-            .collect();
+        let index = model.piece_positions();
         let n = model.pieces().len();
         let by_piece = |map: &'a BTreeMap<String, String>| {
             let mut out = vec![None; n];
