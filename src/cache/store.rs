@@ -19,6 +19,8 @@ const WALLS: &str = "walls";
 const PLANS: &str = "plans";
 /// Entries of `why`'s single-wall cache, kept at the top of the folder.
 const WHY_PREFIX: &str = "sim-";
+/// Threads that write a first run's plan entries.
+const PLAN_WRITERS: usize = 2;
 
 /// A cache folder in use.
 pub struct Cache {
@@ -182,19 +184,70 @@ impl Folder {
         self.entry_path(PLANS, key, "part")
     }
 
+    /// Writes plan entries: their folders first, each once, then the files on
+    /// `PLAN_WRITERS` threads. Creating a file's inode is the kernel's work and takes most of
+    /// the time on some filesystems (ext4 searching its inode groups), so it pays to do it on
+    /// more than one core while the caller builds its output.
     fn put_plans(&self, entries: &[(String, Vec<u8>)]) {
-        for (key, bytes) in entries {
-            self.put(&self.plan_path(key), |w| w.write_all(bytes));
+        let paths: Vec<PathBuf> = entries.iter().map(|(key, _)| self.plan_path(key)).collect();
+        let mut folders: Vec<&Path> = paths.iter().filter_map(|p| p.parent()).collect();
+        folders.sort_unstable();
+        folders.dedup();
+        for folder in folders {
+            if let Err(e) = std::fs::create_dir_all(folder) {
+                self.failed(&e);
+                return;
+            }
         }
+        let write_share = |t: usize| {
+            for (i, (_, bytes)) in entries.iter().enumerate().skip(t).step_by(PLAN_WRITERS) {
+                self.put_in_existing_folder(&paths[i], |w| w.write_all(bytes));
+            }
+        };
+        std::thread::scope(|scope| {
+            for t in 1..PLAN_WRITERS {
+                // No thread to spare: this one writes that share too.
+                if std::thread::Builder::new()
+                    .name("framewright cache writer".into())
+                    .spawn_scoped(scope, move || write_share(t))
+                    .is_err()
+                {
+                    write_share(t);
+                }
+            }
+            write_share(0);
+        });
     }
 
-    /// Writes one entry; a failure turns writing off for this run and leaves a warning.
+    /// Writes one entry, making its folder; a failure turns writing off for this run and
+    /// leaves a warning.
     fn put(&self, path: &Path, write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>) {
         if self.write_failed.load(Ordering::Relaxed) {
             return;
         }
-        if let Err(e) = write_atomically(path, write)
-            && !self.write_failed.swap(true, Ordering::Relaxed)
+        match path.parent().map(std::fs::create_dir_all) {
+            Some(Err(e)) => self.failed(&e),
+            _ => self.put_in_existing_folder(path, write),
+        }
+    }
+
+    /// `put` into a folder known to exist.
+    fn put_in_existing_folder(
+        &self,
+        path: &Path,
+        write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+    ) {
+        if self.write_failed.load(Ordering::Relaxed) {
+            return;
+        }
+        if let Err(e) = crate::atomic::write_entry_with(path, |w| write(w)) {
+            self.failed(&e);
+        }
+    }
+
+    /// Turns writing off for this run, with one warning (the first failure's).
+    fn failed(&self, e: &std::io::Error) {
+        if !self.write_failed.swap(true, Ordering::Relaxed)
             && let Ok(mut w) = self.warning.lock()
         {
             *w = Some(format!(
@@ -204,17 +257,6 @@ impl Folder {
             ));
         }
     }
-}
-
-fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .ok_or_else(|| std::io::Error::other("an entry path has no folder"))?;
-    std::fs::create_dir_all(dir)?;
-    crate::atomic::write_entry_with(path, |w| write(w))
 }
 
 /// What a cache folder holds.
