@@ -32,15 +32,39 @@ pub fn write_entry_with(
     write_via_temp(path, fill, false)
 }
 
+/// A cache entry written beside `path` and not yet in place: `tempfile::TempPath::persist`
+/// renames it there; dropping it removes it. Lets a caller write entries while it works
+/// and show them only once the whole run has succeeded.
+pub fn write_entry_beside(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<tempfile::TempPath> {
+    Ok(write_temp_beside(path, fill)?.into_temp_path())
+}
+
 fn write_via_temp(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
     durable: bool,
 ) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    let tmp = write_temp_beside(path, fill)?;
+    if durable {
+        tmp.as_file().sync_all()?;
+    }
+    // Dropping `tmp` on any error above removes the temporary file.
+    tmp.persist(path).map_err(|e| e.error)?;
+    // Make the rename itself durable; not every platform can open a folder.
+    if durable && let Ok(d) = std::fs::File::open(folder_of(path)) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// `fill` written to a new temporary file in `path`'s folder.
+fn write_temp_beside(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<tempfile::NamedTempFile> {
     let name = path.file_name().ok_or_else(|| {
         std::io::Error::other(format!("the output path {} names no file", path.display()))
     })?;
@@ -48,20 +72,19 @@ fn write_via_temp(
     let tmp = tempfile::Builder::new()
         .prefix(&format!(".{}.", name.to_string_lossy()))
         .suffix(".tmp")
-        .tempfile_in(dir)?;
+        .tempfile_in(folder_of(path))?;
     {
         let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file());
         fill(&mut w)?;
         w.flush()?;
     }
-    if durable {
-        tmp.as_file().sync_all()?;
+    Ok(tmp)
+}
+
+/// The folder `path` is in ("." for a bare file name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
     }
-    // Dropping `tmp` on any error above removes the temporary file.
-    tmp.persist(path).map_err(|e| e.error)?;
-    // Make the rename itself durable; not every platform can open a folder.
-    if durable && let Ok(d) = std::fs::File::open(dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
 }

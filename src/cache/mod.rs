@@ -4,6 +4,7 @@
 
 pub mod key;
 pub mod plan;
+pub mod plan_writer;
 pub mod record_codec;
 pub mod sim;
 pub mod store;
@@ -11,6 +12,7 @@ pub mod trace_codec;
 pub mod value_codec;
 
 pub use plan::{reason_plan_cached, reason_plan_cached_with};
+pub use plan_writer::PlanWriter;
 pub use sim::{
     CacheCounts, Need, Shard, ShardRun, cached_simulation, simulate_cached, simulate_cached_for,
     simulate_shard,

@@ -9,7 +9,7 @@
 
 use super::key::build_id_noted;
 use super::value_codec::{Reader, Writer};
-use super::{Cache, CacheCounts};
+use super::{Cache, CacheCounts, PlanWriter};
 use crate::cell::{Cell, OffsetX};
 use crate::frame::partition::{Indices, Partition};
 use crate::frame::placement::{
@@ -139,17 +139,19 @@ pub fn reason_plan_cached_with<T: Send>(
     let total = std::sync::atomic::AtomicU64::new(0);
     let computed: Mutex<Vec<(usize, Relations)>> = Mutex::new(Vec::new());
     let memo = SearchMemo::default();
+    let writer = cache.plan_writer();
     jobs.par_iter()
         .try_for_each(|job| -> Result<(), FrameError> {
             let (done, tuples) = job.run(&facts, &partition, cell, &memo)?;
             let sum = total.fetch_add(tuples, std::sync::atomic::Ordering::Relaxed) + tuples;
             limits.check_tuples(sum)?;
             for (i, relations) in &done {
-                cache.put_plan(&keys[*i], &encode(&keys[*i], relations));
+                writer.put(keys[*i].clone(), encode(&keys[*i], relations));
             }
             computed.lock().map_err(|_| poisoned())?.extend(done);
             Ok(())
         })?;
+    writer.commit();
     for (i, relations) in computed.into_inner().map_err(|_| poisoned())? {
         if results[i].is_none() {
             let walls = relations.get("wall").map_or(0, Vec::len);
@@ -195,8 +197,8 @@ struct Stored<'a> {
 }
 
 /// A first run (nothing cached): the model reasoned as `plan` does without the cache (one
-/// placement search over every wall, so repeated walls search once), its parts stored while
-/// `then` runs.
+/// placement search over every wall, so repeated walls search once), its parts' entries
+/// written while `then` runs.
 fn first_run<T: Send>(
     facts: Facts,
     cell: &Cell,
@@ -208,7 +210,13 @@ fn first_run<T: Send>(
     wanted.push(REACH);
     let mut reasoned = reason_placed(facts, cell, &RuleEngine::Compiled, &wanted, limits)?;
     let relations = &reasoned.relations;
-    let (rejected, after) = rayon::join(|| store_parts(relations, &stored), || then(relations));
+    let writer = stored.cache.plan_writer();
+    let everything: Vec<usize> = (0..stored.partition.parts.len()).collect();
+    let (rejected, after) = rayon::join(
+        || store_shares(relations, &everything, &stored, &writer),
+        || then(relations),
+    );
+    writer.commit();
     reasoned.relations.remove(REACH);
     let counts = CacheCounts {
         computed: reasoned.get("wall").len(),
@@ -218,26 +226,24 @@ fn first_run<T: Send>(
     Ok((reasoned, counts, after))
 }
 
-/// Splits a whole run's relations into the parts' entries, encodes them, and leaves them to
-/// be written behind; returns how many walls replace entries that were found rejected.
-fn store_parts(relations: &Relations, stored: &Stored) -> usize {
-    let everything: Vec<usize> = (0..stored.partition.parts.len()).collect();
-    let shares = shares(stored.partition, &everything, relations);
-    let wall_slot = relations.keys().position(|n| n == "wall");
-    let keys = stored.keys;
-    let (walls, entries): (Vec<usize>, Vec<(String, Vec<u8>)>) = shares
+/// Splits a run's relations into the entries of `parts` (every part the run reasoned),
+/// encodes them and hands them to the writer; returns how many walls replace entries that
+/// were found rejected.
+fn store_shares(out: &Relations, parts: &[usize], stored: &Stored, writer: &PlanWriter) -> usize {
+    let shares = shares(stored.partition, parts, out);
+    let wall_slot = out.keys().position(|n| n == "wall");
+    shares
         .par_iter()
-        .enumerate()
-        .map(|(i, share)| {
-            let bytes = encode_share(&keys[i], relations, share);
-            let walls = share.iter().filter(|(r, _)| Some(*r) == wall_slot).count();
-            (walls, (keys[i].clone(), bytes))
+        .zip(parts)
+        .map(|(share, &i)| {
+            let key = &stored.keys[i];
+            writer.put(key.clone(), encode_share(key, out, share));
+            if stored.rejected[i] {
+                share.iter().filter(|(r, _)| Some(*r) == wall_slot).count()
+            } else {
+                0
+            }
         })
-        .unzip();
-    stored.cache.put_plans_behind(entries);
-    (0..walls.len())
-        .filter(|&i| stored.rejected[i])
-        .map(|i| walls[i])
         .sum()
 }
 

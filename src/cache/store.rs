@@ -19,21 +19,19 @@ const WALLS: &str = "walls";
 const PLANS: &str = "plans";
 /// Entries of `why`'s single-wall cache, kept at the top of the folder.
 const WHY_PREFIX: &str = "sim-";
-/// Threads that write a first run's plan entries.
-const PLAN_WRITERS: usize = 2;
 
 /// A cache folder in use.
 pub struct Cache {
-    shared: Arc<Folder>,
-    /// Entries being written behind the caller's back (`put_plans_behind`); joined by the
+    pub(super) shared: Arc<Folder>,
+    /// Entries being written behind the caller's back (`PlanWriter`); joined by the
     /// next lookup of plan entries, by `take_warning` and on drop.
     behind: Mutex<Vec<JoinHandle<()>>>,
 }
 
 /// What the writers of a cache folder share.
-struct Folder {
+pub(super) struct Folder {
     dir: PathBuf,
-    write_failed: AtomicBool,
+    pub(super) write_failed: AtomicBool,
     warning: Mutex<Option<String>>,
 }
 
@@ -87,23 +85,7 @@ impl Cache {
             .put(&self.shared.plan_path(key), |w| w.write_all(bytes));
     }
 
-    /// Stores plan part entries (key, bytes) on a thread of their own, so the caller goes on
-    /// while the files are written; each is written like `put_plan`. The next lookup, the
-    /// write warning and dropping the cache wait for them.
-    pub fn put_plans_behind(&self, entries: Vec<(String, Vec<u8>)>) {
-        let entries = Arc::new(entries);
-        let (folder, job) = (Arc::clone(&self.shared), Arc::clone(&entries));
-        match std::thread::Builder::new()
-            .name("framewright cache writer".into())
-            .spawn(move || folder.put_plans(&job))
-        {
-            Ok(handle) => self.pending().push(handle),
-            // No thread to spare: write them now.
-            Err(_) => self.shared.put_plans(&entries),
-        }
-    }
-
-    fn pending(&self) -> std::sync::MutexGuard<'_, Vec<JoinHandle<()>>> {
+    pub(super) fn pending(&self) -> std::sync::MutexGuard<'_, Vec<JoinHandle<()>>> {
         // A writer that panicked left no half entry (entries are renamed into place whole);
         // its handles are still there to join.
         self.behind.lock().unwrap_or_else(|e| e.into_inner())
@@ -180,43 +162,8 @@ impl Folder {
             .join(format!("{key}.{extension}"))
     }
 
-    fn plan_path(&self, key: &str) -> PathBuf {
+    pub(super) fn plan_path(&self, key: &str) -> PathBuf {
         self.entry_path(PLANS, key, "part")
-    }
-
-    /// Writes plan entries: their folders first, each once, then the files on
-    /// `PLAN_WRITERS` threads. Creating a file's inode is the kernel's work and takes most of
-    /// the time on some filesystems (ext4 searching its inode groups), so it pays to do it on
-    /// more than one core while the caller builds its output.
-    fn put_plans(&self, entries: &[(String, Vec<u8>)]) {
-        let paths: Vec<PathBuf> = entries.iter().map(|(key, _)| self.plan_path(key)).collect();
-        let mut folders: Vec<&Path> = paths.iter().filter_map(|p| p.parent()).collect();
-        folders.sort_unstable();
-        folders.dedup();
-        for folder in folders {
-            if let Err(e) = std::fs::create_dir_all(folder) {
-                self.failed(&e);
-                return;
-            }
-        }
-        let write_share = |t: usize| {
-            for (i, (_, bytes)) in entries.iter().enumerate().skip(t).step_by(PLAN_WRITERS) {
-                self.put_in_existing_folder(&paths[i], |w| w.write_all(bytes));
-            }
-        };
-        std::thread::scope(|scope| {
-            for t in 1..PLAN_WRITERS {
-                // No thread to spare: this one writes that share too.
-                if std::thread::Builder::new()
-                    .name("framewright cache writer".into())
-                    .spawn_scoped(scope, move || write_share(t))
-                    .is_err()
-                {
-                    write_share(t);
-                }
-            }
-            write_share(0);
-        });
     }
 
     /// Writes one entry, making its folder; a failure turns writing off for this run and
@@ -225,28 +172,17 @@ impl Folder {
         if self.write_failed.load(Ordering::Relaxed) {
             return;
         }
-        match path.parent().map(std::fs::create_dir_all) {
-            Some(Err(e)) => self.failed(&e),
-            _ => self.put_in_existing_folder(path, write),
-        }
-    }
-
-    /// `put` into a folder known to exist.
-    fn put_in_existing_folder(
-        &self,
-        path: &Path,
-        write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
-    ) {
-        if self.write_failed.load(Ordering::Relaxed) {
-            return;
-        }
-        if let Err(e) = crate::atomic::write_entry_with(path, |w| write(w)) {
+        let written = match path.parent().map(std::fs::create_dir_all) {
+            Some(Err(e)) => Err(e),
+            _ => crate::atomic::write_entry_with(path, |w| write(w)),
+        };
+        if let Err(e) = written {
             self.failed(&e);
         }
     }
 
     /// Turns writing off for this run, with one warning (the first failure's).
-    fn failed(&self, e: &std::io::Error) {
+    pub(super) fn failed(&self, e: &std::io::Error) {
         if !self.write_failed.swap(true, Ordering::Relaxed)
             && let Ok(mut w) = self.warning.lock()
         {
@@ -411,7 +347,9 @@ mod tests {
         std::fs::create_dir_all(dir.path().join("cache").join(PLANS)).expect("plans folder");
         assert!(!cache.may_hold_plans(), "an empty plans folder");
         // Entries still being written behind count: the check waits for them.
-        cache.put_plans_behind(vec![("ab12".into(), b"entry".to_vec())]);
+        let writer = cache.plan_writer();
+        writer.put("ab12".into(), b"entry".to_vec());
+        writer.commit();
         assert!(cache.may_hold_plans());
         assert_eq!(cache.get_plan("ab12").as_deref(), Some(&b"entry"[..]));
     }
