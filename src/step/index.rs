@@ -4,6 +4,7 @@ use super::error::{StepError, StepErrorKind};
 use super::header::Header;
 use super::params::{self, Entity, skip_ws};
 use super::source::{ReadOptions, Source};
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::path::Path;
 
@@ -36,6 +37,8 @@ pub struct StepFile {
     type_names: Vec<String>,
     by_type: Vec<Vec<u32>>,
     max_depth: usize,
+    /// How many parallel chunks the DATA scan used (1: one pass).
+    scan_chunks: usize,
 }
 
 const NO_RECORD: u32 = u32::MAX;
@@ -80,6 +83,7 @@ impl StepFile {
             type_names: raw.type_names,
             by_type: Vec::new(),
             max_depth: options.max_depth,
+            scan_chunks: raw.chunks,
             source,
         };
         file.build_lookup()?;
@@ -145,6 +149,11 @@ impl StepFile {
 
     pub fn is_empty(&self) -> bool {
         self.records.is_empty()
+    }
+
+    /// How many parallel chunks indexed the DATA section (1: one pass).
+    pub fn scan_chunks(&self) -> usize {
+        self.scan_chunks
     }
 
     pub fn records(&self) -> &[Record] {
@@ -242,6 +251,7 @@ fn located(bytes: &[u8], offset: usize, kind: StepErrorKind, entity: Option<u64>
 struct RawIndex {
     records: Vec<Record>,
     type_names: Vec<String>,
+    chunks: usize,
 }
 
 type ScanError = (usize, StepErrorKind, Option<u64>);
@@ -254,8 +264,21 @@ struct Scanner<'a> {
     max_instances: usize,
     max_string_bytes: usize,
     types: FxHashMap<&'a [u8], TypeId>,
+    /// Each type id's name as written (what `types` is keyed by).
+    raw_type_names: Vec<&'a [u8]>,
     index: RawIndex,
 }
+
+/// Where a scan of statements stopped.
+enum Stop {
+    /// At the first statement starting at or after the limit (this offset).
+    Reached(usize),
+    /// After the section's ENDSEC.
+    EndSection,
+}
+
+/// DATA sections smaller than this per thread are scanned in one pass.
+const MIN_CHUNK_BYTES: usize = 1 << 20;
 
 impl<'a> Scanner<'a> {
     fn new(bytes: &'a [u8], options: &ReadOptions) -> Self {
@@ -266,10 +289,12 @@ impl<'a> Scanner<'a> {
             max_instances: options.max_instances,
             max_string_bytes: options.max_string_bytes,
             types: FxHashMap::default(),
+            raw_type_names: Vec::new(),
             // Instances take 40+ bytes in practice; reserving avoids regrowth copies.
             index: RawIndex {
                 records: Vec::with_capacity((bytes.len() / 48).min(options.max_instances)),
                 type_names: Vec::new(),
+                chunks: 1,
             },
         }
     }
@@ -337,7 +362,9 @@ impl<'a> Scanner<'a> {
                 return Err((self.pos, kind, None));
             }
             sections += 1;
-            self.scan_data()?;
+            if sections > 1 || !self.scan_data_in_chunks() {
+                self.scan_data()?;
+            }
         }
         Ok((header, self.index))
     }
@@ -417,10 +444,124 @@ impl<'a> Scanner<'a> {
     }
 
     fn scan_data(&mut self) -> Result<(), ScanError> {
+        self.scan_data_until(usize::MAX).map(|_| ())
+    }
+
+    /// The first DATA section scanned in parallel chunks, each starting after a `;` that is
+    /// followed by `#`. Such a `;` may still be inside a string or comment, so chunks are
+    /// joined in order from where the one before truly ended: a chunk that started there is
+    /// kept, one that did not is scanned again from there. Every record therefore comes from
+    /// a scan that started at a true statement boundary, and the index is exactly one pass's.
+    /// Returns false, with nothing indexed, when a chunk meets an error (one pass then reports
+    /// it where it is) or the section ends before the last chunk (more sections follow), or
+    /// when the section is too small to be worth splitting.
+    fn scan_data_in_chunks(&mut self) -> bool {
+        let start = self.pos;
+        let len = self.bytes.len() - start;
+        let n = rayon::current_num_threads().min(len / MIN_CHUNK_BYTES);
+        if n < 2 {
+            return false;
+        }
+        let mut starts = vec![start];
+        for k in 1..n {
+            let nominal = (start + k * (len / n)).max(starts[k - 1]);
+            match self.statement_start_after(nominal) {
+                Some(p) => starts.push(p),
+                None => break,
+            }
+        }
+        let ends: Vec<usize> = starts.iter().skip(1).copied().chain([usize::MAX]).collect();
+        let scan = |from: usize, until: usize| {
+            let mut chunk = self.chunk_from(from, until.min(self.bytes.len()) - from);
+            let stop = chunk.scan_data_until(until).ok()?;
+            Some((chunk, stop))
+        };
+        let scanned: Vec<Option<(Scanner<'a>, Stop)>> = starts
+            .par_iter()
+            .zip(&ends)
+            .map(|(&from, &until)| scan(from, until))
+            .collect();
+        let last = scanned.len() - 1;
+        let mut joined: Vec<Scanner<'a>> = Vec::with_capacity(scanned.len());
+        let mut at = start;
+        for (k, chunk) in scanned.into_iter().enumerate() {
+            let chunk = match chunk {
+                Some(c) if starts[k] == at => c,
+                _ => match scan(at, ends[k]) {
+                    Some(c) => c,
+                    None => return false,
+                },
+            };
+            match chunk.1 {
+                Stop::Reached(end) if k < last => at = end,
+                Stop::EndSection if k == last => {}
+                _ => return false,
+            }
+            joined.push(chunk.0);
+        }
+        let count: usize = joined.iter().map(|c| c.index.records.len()).sum();
+        if count > self.max_instances {
+            return false;
+        }
+        self.index.records.reserve(count);
+        for chunk in joined {
+            // Chunk type ids to the file's, in order of first use as one pass assigns them.
+            let ids: Vec<TypeId> = chunk
+                .raw_type_names
+                .iter()
+                .map(|raw| self.intern(raw))
+                .collect();
+            self.index
+                .records
+                .extend(chunk.index.records.into_iter().map(|r| Record {
+                    type_id: ids[r.type_id as usize],
+                    ..r
+                }));
+            self.pos = chunk.pos;
+        }
+        self.index.chunks = starts.len();
+        true
+    }
+
+    /// The offset just after the first `;` at or after `from` that white space and `#` follow.
+    fn statement_start_after(&self, mut from: usize) -> Option<usize> {
         loop {
+            let p = from + memchr::memchr(b';', &self.bytes[from..])? + 1;
+            if self.bytes[p..].trim_ascii_start().first() == Some(&b'#') {
+                return Some(p);
+            }
+            from = p;
+        }
+    }
+
+    /// A scanner of the same file from `from`, for a chunk of about `len` bytes.
+    fn chunk_from(&self, from: usize, len: usize) -> Scanner<'a> {
+        Scanner {
+            bytes: self.bytes,
+            pos: from,
+            max_depth: self.max_depth,
+            max_instances: self.max_instances,
+            max_string_bytes: self.max_string_bytes,
+            types: FxHashMap::default(),
+            raw_type_names: Vec::new(),
+            index: RawIndex {
+                records: Vec::with_capacity((len / 48).min(self.max_instances)),
+                type_names: Vec::new(),
+                chunks: 1,
+            },
+        }
+    }
+
+    /// Scans statements until ENDSEC or until the next statement would start at or after
+    /// `until`.
+    fn scan_data_until(&mut self, until: usize) -> Result<Stop, ScanError> {
+        loop {
+            if self.pos >= until {
+                return Ok(Stop::Reached(self.pos));
+            }
             self.skip();
             if self.keyword_statement(b"ENDSEC") {
-                return Ok(());
+                return Ok(Stop::EndSection);
             }
             let start = self.pos;
             let rest = self.rest();
@@ -517,6 +658,7 @@ impl<'a> Scanner<'a> {
         self.index
             .type_names
             .push(String::from_utf8_lossy(name).to_ascii_uppercase());
+        self.raw_type_names.push(name);
         self.types.insert(name, t);
         t
     }
@@ -643,5 +785,106 @@ mod tests {
         };
         let e = StepFile::from_bytes(GOOD.as_bytes().to_vec(), &options).unwrap_err();
         assert!(matches!(e.kind, StepErrorKind::TooLarge { .. }));
+    }
+
+    /// A file of `n` entities with `middle` (entity statements) placed halfway, big enough
+    /// to be scanned in chunks.
+    fn big_file(n: usize, middle: &str) -> String {
+        let mut text = String::from(
+            "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\nFILE_NAME('','',(''),(''),'','','');\nFILE_SCHEMA(('IFC4'));\nENDSEC;\nDATA;\n",
+        );
+        for i in 1..=n {
+            if i == n / 2 {
+                text.push_str(middle);
+            }
+            // Strings and comments with `;` everywhere a chunk might start.
+            match i % 3 {
+                0 => text.push_str(&format!("#{i}=IFCLABEL('x;{i};#9=IFCX((1.));');\n")),
+                1 => text.push_str(&format!(
+                    "/* ;#{i}=( */#{i}= IfcCartesianPoint((0.,{i}.,2.));\n"
+                )),
+                _ => text.push_str(&format!("#{i}=IFCDIRECTION((1.,0.,0.));\n")),
+            }
+        }
+        text.push_str("ENDSEC;\nEND-ISO-10303-21;\n");
+        text
+    }
+
+    /// The file read in one pass (one thread) and in chunks (four threads).
+    fn read_both(text: &str) -> [Result<StepFile, StepError>; 2] {
+        [1, 4].map(|threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            pool.install(|| read(text))
+        })
+    }
+
+    /// Each record as (id, type, start, parameters), and the type names.
+    type Index = (Vec<(u64, u32, usize, (usize, usize))>, Vec<String>);
+
+    fn index_of(f: &StepFile) -> Index {
+        let records = f
+            .records()
+            .iter()
+            .map(|r| (r.id, r.type_id, r.start, r.params))
+            .collect();
+        (records, f.type_names.clone())
+    }
+
+    #[test]
+    fn chunks_index_exactly_what_one_pass_does() {
+        let long_string = format!("#999999=IFCLABEL('{}');\n", ";#1=A(1);".repeat(200_000));
+        let long_comment = format!("/* {} */\n", ";#1=A(1);".repeat(200_000));
+        let second_section = "ENDSEC;\nDATA;\n#888888=IFCLABEL('s');\n";
+        // Four chunks, some starting inside the long string or comment (scanned again from
+        // where the chunk before ended); a second section falls back to one pass.
+        for (middle, chunks) in [
+            ("", 4),
+            (long_string.as_str(), 4),
+            (long_comment.as_str(), 4),
+            (second_section, 1),
+        ] {
+            let text = big_file(100_000, middle);
+            assert!(text.len() > 4 * MIN_CHUNK_BYTES, "{}", text.len());
+            let [one, chunked] = read_both(&text);
+            let (one, chunked) = (one.expect("reads"), chunked.expect("reads"));
+            assert_eq!(index_of(&one), index_of(&chunked));
+            assert_eq!((one.scan_chunks(), chunked.scan_chunks()), (1, chunks));
+            assert!(one.len() >= 100_000);
+            assert_eq!(
+                chunked.entity(2).unwrap().unwrap().type_name,
+                "IFCDIRECTION"
+            );
+        }
+    }
+
+    #[test]
+    fn chunks_report_an_error_where_one_pass_does() {
+        for middle in [
+            "#5=IFCLABEL('unclosed);\n",
+            "#5 IFCLABEL('a');\n",
+            "#5=IFCLABEL('a';\n",
+            "#40000=IFCLABEL('taken');\n",
+        ] {
+            let text = big_file(100_000, middle);
+            let [one, chunked] = read_both(&text);
+            let (one, chunked) = (one.expect_err("fails"), chunked.expect_err("fails"));
+            assert_eq!(
+                (one.to_string(), one.line, one.column, one.entity),
+                (
+                    chunked.to_string(),
+                    chunked.line,
+                    chunked.column,
+                    chunked.entity
+                )
+            );
+        }
+        let truncated = big_file(100_000, "");
+        let truncated = &truncated[..truncated.len() * 3 / 4];
+        let [one, chunked] = read_both(truncated);
+        let (one, chunked) = (one.expect_err("fails"), chunked.expect_err("fails"));
+        assert_eq!(one.to_string(), chunked.to_string());
     }
 }
