@@ -211,9 +211,8 @@ fn first_run<T: Send>(
     let mut reasoned = reason_placed(facts, cell, &RuleEngine::Compiled, &wanted, limits)?;
     let relations = &reasoned.relations;
     let writer = stored.cache.plan_writer();
-    let everything: Vec<usize> = (0..stored.partition.parts.len()).collect();
     let (rejected, after) = rayon::join(
-        || store_shares(relations, &everything, &stored, &writer),
+        || store_parts(relations, &stored, &writer),
         || then(relations),
     );
     writer.commit();
@@ -226,16 +225,16 @@ fn first_run<T: Send>(
     Ok((reasoned, counts, after))
 }
 
-/// Splits a run's relations into the entries of `parts` (every part the run reasoned),
-/// encodes them and hands them to the writer; returns how many walls replace entries that
-/// were found rejected.
-fn store_shares(out: &Relations, parts: &[usize], stored: &Stored, writer: &PlanWriter) -> usize {
-    let shares = shares(stored.partition, parts, out);
+/// Splits a whole run's relations into the parts' entries, encodes them and hands them to
+/// the writer; returns how many walls replace entries that were found rejected.
+fn store_parts(out: &Relations, stored: &Stored, writer: &PlanWriter) -> usize {
+    let everything: Vec<usize> = (0..stored.partition.parts.len()).collect();
+    let shares = shares(stored.partition, &everything, out);
     let wall_slot = out.keys().position(|n| n == "wall");
     shares
         .par_iter()
-        .zip(parts)
-        .map(|(share, &i)| {
+        .enumerate()
+        .map(|(i, share)| {
             let key = &stored.keys[i];
             writer.put(key.clone(), encode_share(key, out, share));
             if stored.rejected[i] {

@@ -1,9 +1,9 @@
 //! Writes `plan`'s part entries while the run goes on, and shows them only if it succeeds.
-//! Entries go to threads of their own as they are encoded (a storey's as soon as its rules
-//! finish); each is written beside its final name and renamed into place on `commit`. A run
-//! that fails (a rule bound, an error in a later storey) removes what it wrote, so the cache
-//! never holds a part of a run that did not finish: a later run under the same bounds reasons
-//! as much as an uncached one and stops where it stops.
+//! Entries go to threads of their own as they are encoded; each is written beside its final
+//! name and renamed into place on `commit`. A run that fails (a rule bound, an error in a
+//! later storey) removes what it wrote, so the cache never holds a part of a run that did
+//! not finish: a later run under the same bounds reasons as much as an uncached one and
+//! stops where it stops.
 //!
 //! Creating a file (its inode) is the kernel's work and on some filesystems most of the
 //! writing (ext4 searching its inode groups, slower still just after a large delete), so
