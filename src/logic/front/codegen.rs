@@ -4,7 +4,8 @@
 //!
 //! Aggregates become an auxiliary relation holding one tuple per match of the
 //! aggregate body (outer variables, the aggregated value, the body's other
-//! variables), aggregated with ascent's `agg` clause; negated atoms with `_`
+//! variables; min and max only the outer variables and the value), aggregated
+//! with ascent's `agg` clause; negated atoms with `_`
 //! become a projection relation.
 
 use super::Program;
@@ -461,7 +462,14 @@ impl Gen<'_> {
             cols.push(rust_ty(target_ty));
             head.push(self.expr(t, &inner)?);
         }
-        for (v, t) in &locals {
+        // Each match counts for count, sum and mean, so their tuples keep the body's other
+        // variables; the least or greatest value is the same over the distinct values, so
+        // min and max keep only the value (no boxes or poses hashed per match).
+        let witnesses: &[(String, BaseTy)] = match g.op {
+            AggOp::Min | AggOp::Max if g.target.is_some() => &[],
+            _ => &locals,
+        };
+        for (v, t) in witnesses {
             cols.push(rust_ty(*t));
             head.push(format!("{}.clone()", var_name(v)));
         }
@@ -482,7 +490,7 @@ impl Gen<'_> {
         if g.target.is_some() {
             pats.push(t.clone());
         }
-        pats.extend(locals.iter().map(|_| "_".to_string()));
+        pats.extend(witnesses.iter().map(|_| "_".to_string()));
         let suffix = match target_ty {
             BaseTy::Number => "i64",
             BaseTy::Unsigned => "u64",
