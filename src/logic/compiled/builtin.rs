@@ -45,15 +45,18 @@ macro_rules! outputs {
         fn $f(p: &$prog, wanted: &[&str], out: &mut Relations) {
             $(
                 if wanted.contains(&$name) {
-                    let mut v: Vec<Vec<Value>> = p
-                        .$field
-                        .iter()
+                    // Sorted as typed tuples, whose order is the `Value` tuples' (each
+                    // column's type orders as its `Value` variant, tuples and vectors of
+                    // one length lexicographically), so no `Value` is compared. Equal
+                    // tuples are identical and deduplicated: the unstable sort gives the
+                    // stable order.
+                    let mut typed: Vec<_> = p.$field.iter().collect();
+                    typed.sort_unstable();
+                    typed.dedup();
+                    let v: Vec<Vec<Value>> = typed
+                        .into_iter()
                         .map(|t| vec![$(t.$i.clone().into_value()),*])
                         .collect();
-                    // Equal tuples are identical (`Value`'s order agrees with its
-                    // equality) and deduplicated: the unstable sort gives the stable order.
-                    v.sort_unstable();
-                    v.dedup();
                     out.insert($name.to_string(), v);
                 }
             )*
@@ -279,5 +282,40 @@ mod tests {
         assert!(!cut.relations["framing_target"].is_empty());
         assert_eq!(cut.relations, whole.relations);
         assert!(cut.tuples < whole.tuples, "the cut copy derives less");
+    }
+
+    #[test]
+    fn typed_tuples_sort_as_their_values() {
+        use crate::logic::value::Column;
+        // Symbols interned out of their text's order, signed zeros, NaN and vectors that
+        // differ only in a later coordinate: the typed order must be the `Value` order.
+        let syms: Vec<Sym> = ["m", "b", "z", "a"].iter().map(|s| Sym::from(*s)).collect();
+        let floats = [0.0, -0.0, f64::NAN, -1.5, 2.0, f64::INFINITY];
+        let vecs = [
+            Vec3::new(1.0, 0.0, -0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(-1.0, 2.0, 0.0),
+        ];
+        let mut typed: Vec<(Sym, F64, Vec3, i64)> = Vec::new();
+        for (i, s) in syms.iter().enumerate() {
+            for (j, x) in floats.iter().enumerate() {
+                for v in &vecs {
+                    typed.push((*s, F64(*x), *v, (i as i64 - j as i64) % 3));
+                }
+            }
+        }
+        typed.reverse();
+        let as_values = |t: &(Sym, F64, Vec3, i64)| {
+            vec![
+                t.0.into_value(),
+                t.1.into_value(),
+                t.2.into_value(),
+                t.3.into_value(),
+            ]
+        };
+        let mut by_value: Vec<Vec<Value>> = typed.iter().map(as_values).collect();
+        by_value.sort();
+        typed.sort_unstable();
+        assert_eq!(typed.iter().map(as_values).collect::<Vec<_>>(), by_value);
     }
 }
