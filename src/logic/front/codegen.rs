@@ -5,8 +5,8 @@
 //! Aggregates become an auxiliary relation holding one tuple per match of the
 //! aggregate body (outer variables, the aggregated value, the body's other
 //! variables; min and max only the outer variables and the value), aggregated
-//! with ascent's `agg` clause; negated atoms with `_`
-//! become a projection relation.
+//! with ascent's `agg` clause; negated atoms with `_` become a projection
+//! relation.
 
 use super::Program;
 use super::ast::*;
