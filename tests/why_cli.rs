@@ -344,3 +344,51 @@ fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
             .contains(&serde_json::json!(174))
     );
 }
+
+#[test]
+fn why_takes_the_cache_options_of_the_other_commands() {
+    // `--cache DIR` as `plan` and `simulate` take it; `--no-cache` simulates afresh and
+    // leaves no entry, not even in the default folder.
+    let m = tm3();
+    let m = m.to_str().unwrap();
+    let named = tempfile::tempdir().unwrap();
+    let default = tempfile::tempdir().unwrap();
+    let why = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
+            .args(["why", "--offset-x", "0.531", m, "#174"])
+            .args(extra)
+            .env("FRAMEWRIGHT_CACHE", default.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{extra:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let entries = |dir: &Path| std::fs::read_dir(dir).unwrap().count();
+
+    let first = why(&["--cache", named.path().to_str().unwrap()]);
+    assert!(
+        first.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"),
+        "{first}"
+    );
+    assert!(entries(named.path()) > 0, "the named folder holds the wall");
+    let again = why(&["--cache", named.path().to_str().unwrap()]);
+    assert!(again.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ (from the cache)\n"));
+
+    let fresh = why(&["--no-cache"]);
+    assert!(
+        fresh.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"),
+        "{fresh}"
+    );
+    assert_eq!(entries(default.path()), 0, "--no-cache wrote nothing");
+    assert_eq!(
+        first.lines().skip(1).collect::<Vec<_>>(),
+        fresh.lines().skip(1).collect::<Vec<_>>()
+    );
+
+    let err = bad(&["why", m, "#174", "--no-cache", "--cache", "x"]);
+    assert!(err.contains("cannot be used with"), "{err}");
+}

@@ -49,9 +49,12 @@ pub struct Common {
     /// Explain the plan only: do not simulate the element's wall.
     #[arg(long)]
     pub no_simulate: bool,
-    /// Where simulated walls are cached (default: $FRAMEWRIGHT_CACHE, $XDG_CACHE_HOME/framewright or ~/.cache/framewright).
-    #[arg(long, value_name = "DIR")]
+    /// Where simulated walls are cached (default: $FRAMEWRIGHT_CACHE, $XDG_CACHE_HOME/framewright or ~/.cache/framewright); `--cache-dir` is the same option.
+    #[arg(long = "cache", alias = "cache-dir", value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
+    /// Neither read nor write the cache: simulate the wall afresh.
+    #[arg(long, conflicts_with = "cache_dir")]
+    pub no_cache: bool,
 }
 
 /// A wall simulated for the explanation.
@@ -89,7 +92,11 @@ fn simulate_walls(
             }
         }
     }
-    let cache = c.cache_dir.clone().or_else(default_cache_dir);
+    let cache = if c.no_cache {
+        None
+    } else {
+        c.cache_dir.clone().or_else(default_cache_dir)
+    };
     let mut out = Vec::new();
     for wall in walls {
         let (sim, cached) =
