@@ -392,3 +392,32 @@ fn why_takes_the_cache_options_of_the_other_commands() {
     let err = bad(&["why", m, "#174", "--no-cache", "--cache", "x"]);
     assert!(err.contains("cannot be used with"), "{err}");
 }
+
+#[test]
+fn a_contact_tolerance_the_simulation_would_not_use_is_refused() {
+    // The executor plans with the default tolerance: explaining its verdicts next to facts
+    // reasoned with another would mix two sets of contacts.
+    let m = tm3();
+    let m = m.to_str().unwrap();
+    for command in [
+        vec!["why", m, "#174", "--contact-tolerance", "5"],
+        vec!["why-not", m, "role(#174, stud)", "--contact-tolerance", "5"],
+    ] {
+        let err = bad(&command);
+        assert!(
+            err.contains("--contact-tolerance cannot be combined with a simulation")
+                && err.contains("add --no-simulate"),
+            "{err}"
+        );
+    }
+    // The plan alone takes it.
+    let plan_only = ok(&[
+        "why",
+        m,
+        "#174",
+        "--contact-tolerance",
+        "5",
+        "--no-simulate",
+    ]);
+    assert!(plan_only.contains("32H5oapRpM57uELNCcVku8"), "{plan_only}");
+}

@@ -46,13 +46,30 @@ pub struct ReasoningInputs {
     #[arg(long, value_name = "DIR")]
     pub rules_dir: Option<PathBuf>,
     /// Largest gap between two pieces still taken as touching, millimetres.
-    #[arg(long, value_name = "MM", default_value_t = 3.0)]
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_CONTACT_TOLERANCE_MM)]
     pub contact_tolerance: f64,
     /// Where walls lie along the robot's x axis, overriding the cell: metres from the base
     /// to the wall's bottom edge, or `auto` (each wall where the arm reaches most of it).
     #[arg(long, value_name = "M|auto")]
     pub offset_x: Option<String>,
 }
+
+impl ReasoningInputs {
+    /// Refuses a contact tolerance other than the default where the executor runs: it plans
+    /// the walls itself, with the default tolerance, and would answer for other contacts
+    /// than the ones reasoned here. `instead` says what the user can do.
+    pub fn tolerance_for_executor(&self, instead: &str) -> Result<(), Failure> {
+        if self.contact_tolerance == DEFAULT_CONTACT_TOLERANCE_MM {
+            return Ok(());
+        }
+        Err(Failure::bad_input(format!(
+            "--contact-tolerance cannot be combined with a simulation (the executor plans with the default tolerance, {DEFAULT_CONTACT_TOLERANCE_MM} mm); {instead}"
+        )))
+    }
+}
+
+/// `--contact-tolerance`'s default, millimetres (`ContactOptions::default`).
+const DEFAULT_CONTACT_TOLERANCE_MM: f64 = 3.0;
 
 /// Loads a cell and applies a command-line `--offset-x`.
 pub fn load_cell(name: &str, offset_x: Option<&str>) -> Result<Cell, Failure> {
@@ -126,11 +143,8 @@ pub fn run(args: CheckArgs) -> CmdResult {
     // Rule files first: a typo fails before the model is read.
     let user = UserRules::load(&args.rules, &base)?;
     if args.simulate {
-        if args.inputs.contact_tolerance != 3.0 {
-            return Err(Failure::bad_input(
-                "--contact-tolerance cannot be combined with --simulate (the executor plans with the default tolerance)",
-            ));
-        }
+        args.inputs
+            .tolerance_for_executor("leave out --simulate to check the plan with this tolerance")?;
         // The executor reads the model and reasons itself.
         let model = Model::open(&args.model)?;
         let cell = load_cell(&args.inputs.cell, args.inputs.offset_x.as_deref())?;

@@ -130,8 +130,20 @@ fn failure(e: WhyError) -> Failure {
     Failure::from(e)
 }
 
+impl Common {
+    /// What the wall's simulation cannot take, refused before the model is read.
+    fn check_simulation(&self) -> Result<(), Failure> {
+        if self.no_simulate {
+            return Ok(());
+        }
+        self.inputs
+            .tolerance_for_executor("add --no-simulate to explain the plan with this tolerance")
+    }
+}
+
 pub fn run_why(args: WhyArgs) -> CmdResult {
     let c = &args.common;
+    c.check_simulation()?;
     let base = rule_base(&c.inputs.rules_dir);
     let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
     // Only the element's containers matter (see `frame::containers`): the placement search
@@ -194,6 +206,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
 
 pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     let c = &args.common;
+    c.check_simulation()?;
     let base = rule_base(&c.inputs.rules_dir);
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
     let ids = piece_ids_in(&model, &args.tuple);
