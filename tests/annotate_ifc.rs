@@ -285,7 +285,10 @@ fn ifcopenshell_validates_and_finds_the_plan() {
         .output()
         .is_ok_and(|o| o.status.success());
     if !rules {
-        eprintln!("EXPRESS where-rules skipped: pytest is absent (pip install pytest)");
+        common::skip::missing_tool(
+            "pytest (IfcOpenShell's EXPRESS where-rules)",
+            "python3 -m pip install pytest",
+        );
     }
     let dir = tempfile::tempdir().unwrap();
     let mut models: Vec<PathBuf> = ["tm1.ifc", "tm2.ifc", "tm3.ifc"]

@@ -119,10 +119,9 @@ fn validate_against_schemas(bcfzip: &Path, version: &str) {
         .unwrap();
     let out = String::from_utf8_lossy(&run.stdout);
     if let Some(looked) = out.strip_prefix("NO-XSD ") {
-        eprintln!(
-            "skipped: no BCF-XML schemas in {}; pip install --no-deps --target \
-             target/bcf-xsd bcf-client==0.7.10",
-            looked.trim()
+        common::skip::missing_tool(
+            &format!("the BCF-XML schemas (looked in {})", looked.trim()),
+            "python3 -m pip install --no-deps --target target/bcf-xsd bcf-client==0.7.10",
         );
         return;
     }

@@ -141,7 +141,7 @@ fn a_shard_is_checked() {
 #[test]
 fn the_gnu_parallel_example_script_assembles_the_full_result() {
     if Command::new("parallel").arg("--version").output().is_err() {
-        eprintln!("skipped: GNU parallel is absent (.ci/run installs it)");
+        common::skip::missing_tool("GNU parallel", "apt-get install parallel");
         return;
     }
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));

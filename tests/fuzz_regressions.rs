@@ -1,7 +1,8 @@
 //! Inputs the fuzzer (`fuzz/run.sh`) found to crash or hang a reader, replayed through the
 //! same calls as the fuzz targets (`fuzz/src/lib.rs`, included here so both run one code).
-//! Each lives in `tests/fixtures/fuzz/<target>/`; every one must now return (an error or a
-//! model) without a panic, well inside the fuzzer's one-second limit. Inputs that are large but
+//! Each lives in `tests/fixtures/fuzz/<target>/` (every target keeps at least one input); every
+//! one must now return (an error or a model) without a panic, well inside the fuzzer's
+//! one-second limit, and the hand-kept ones get the answer named here. Inputs that are large but
 //! regular (deep nesting) are generated here instead, with the message they must now get.
 
 #[path = "../fuzz/src/lib.rs"]
@@ -17,14 +18,13 @@ use std::time::Duration;
 /// that hangs again still does.
 const HANG: Duration = Duration::from_secs(20);
 
-fn replay(target: &str, run: fn(&[u8])) -> usize {
+/// Replays every kept input of `target`; a target must keep at least one.
+fn replay(target: &str, run: fn(&[u8])) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/fixtures/fuzz")
         .join(target);
-    // A target without a kept input has no folder (git keeps no empty folder).
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        return 0;
-    };
+    let entries = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}: no kept input to replay", dir.display()));
     let mut files: Vec<_> = entries
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_none_or(|e| e != "md"))
@@ -48,7 +48,100 @@ fn replay(target: &str, run: fn(&[u8])) -> usize {
             Err(mpsc::RecvTimeoutError::Disconnected) => panic!("{name}: panicked (see above)"),
         }
     }
-    files.len()
+    assert!(
+        !files.is_empty(),
+        "{}: no kept input to replay",
+        dir.display()
+    );
+}
+
+/// A kept input's text, without the byte that picks the reader for `cell_toml`.
+fn kept(path: &str) -> (String, String) {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/fuzz")
+        .join(path);
+    let bytes = std::fs::read(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    (
+        file.display().to_string(),
+        String::from_utf8(bytes).unwrap(),
+    )
+}
+
+// The kept inputs of the targets where no fuzz run found a crash: one of each kind of hostile
+// input the reader must refuse or read, with what it must say. The replays above check that
+// none panics or hangs; these check that each gets its answer.
+#[test]
+fn kept_ifc_inputs_get_their_answers() {
+    use framewright::ifc::Model;
+    use framewright::step::ReadOptions;
+    for (name, says) in [
+        ("truncated-inside-a-string.ifc", Some("looks truncated")),
+        (
+            "placement-cycle.ifc",
+            Some("placement cycle #1 -> #2 -> #1"),
+        ),
+        (
+            "reference-to-an-undefined-entity.ifc",
+            Some("#3 refers to #98, which is not defined in the file"),
+        ),
+        // Read, holding nothing to frame.
+        ("list-nested-5000-deep.ifc", None),
+        ("numbers-out-of-range.ifc", None),
+    ] {
+        let (path, text) = kept(&format!("ifc/{name}"));
+        let answer = Model::from_bytes(&path, text.into_bytes(), &ReadOptions::default());
+        match (answer, says) {
+            (Err(e), Some(says)) => assert!(e.to_string().contains(says), "{path}: {e}"),
+            (Ok(model), Some(says)) => {
+                let warnings: Vec<String> =
+                    model.warnings.iter().map(|w| w.message.clone()).collect();
+                assert!(
+                    warnings.iter().any(|w| w.contains(says)),
+                    "{path}: {warnings:?}"
+                );
+            }
+            (Ok(model), None) => assert!(model.pieces().is_empty(), "{path}"),
+            (Err(e), None) => panic!("{path}: refused: {e}"),
+        }
+    }
+}
+
+#[test]
+fn kept_cell_tool_and_robot_inputs_are_refused_naming_the_key() {
+    use framewright::cell::{Cell, Tool};
+    for (name, says) in [
+        (
+            "cell-nan-belt-speed.toml",
+            "key `conveyor2.speed`: expected a belt speed",
+        ),
+        ("tool-negative-part-mass.toml", "mass"),
+        ("robot-infinite-reach.toml", "reach"),
+    ] {
+        let (path, text) = kept(&format!("cell_toml/{name}"));
+        let (reader, text) = text.split_at(1);
+        let p = Path::new(&path);
+        let message = match reader {
+            "0" => Cell::from_toml(p, text).err().map(|e| e.to_string()),
+            "1" => Tool::parse(p, text).err().map(|e| e.to_string()),
+            _ => RobotMeta::parse(p, text).err().map(|e| e.to_string()),
+        }
+        .unwrap_or_else(|| panic!("{path}: accepted"));
+        assert!(message.contains(says), "{path}: {message}");
+    }
+}
+
+#[test]
+fn kept_urdf_inputs_are_refused_saying_why() {
+    for (name, says) in [
+        ("joint-cycle.urdf", "expected one root link"),
+        ("nan-origin-zero-axis-inverted-limits.urdf", "joint `j1`"),
+    ] {
+        let (path, text) = kept(&format!("urdf/{name}"));
+        let e = Robot::from_urdf_str(Path::new(&path), &text, RobotMeta::default())
+            .err()
+            .unwrap_or_else(|| panic!("{path}: accepted"));
+        assert!(e.to_string().contains(says), "{path}: {e}");
+    }
 }
 
 #[test]

@@ -3,6 +3,8 @@
 //! left. The outputs go to a small tmpfs mounted for the test; where mounting is not allowed
 //! (not root, no CAP_SYS_ADMIN) the test says so and skips.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -25,9 +27,12 @@ impl SmallDisk {
             .output()
             .ok()?;
         if !out.status.success() {
-            eprintln!(
-                "skipped: cannot mount a tmpfs here ({})",
-                String::from_utf8_lossy(&out.stderr).trim()
+            common::skip::missing_tool(
+                &format!(
+                    "a tmpfs mount ({})",
+                    String::from_utf8_lossy(&out.stderr).trim()
+                ),
+                "run the tests as root or with CAP_SYS_ADMIN, as .ci/run does",
             );
             return None;
         }

@@ -4,6 +4,8 @@
 //! holds nothing, the previous version, or the complete new one (outputs are
 //! deterministic, so "complete" means byte-identical to an uninterrupted run).
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -241,7 +243,10 @@ fn a_report_run_removes_the_staging_folders_that_killed_runs_left() {
     assert!(status.success());
     assert!(report.join("index.html").exists());
     if !Path::new("/proc/self").exists() {
-        eprintln!("skipped: this system does not list its processes in /proc");
+        common::skip::missing_tool(
+            "/proc (the process list)",
+            "a Linux system with /proc mounted",
+        );
         return;
     }
     assert!(

@@ -22,7 +22,9 @@ fn run(name: &str, walls: &[&str]) -> (framewright::sim::Simulation, SimReport) 
         ..SimOptions::default()
     };
     // Walls where the study laid its TM3 (0.531 m from the base), lumber end to end: TM1's
-    // bottom plate is then out of the arm's range.
+    // bottom plate then lies too near the base for the arm to fold down to it (a joint limit).
+    // The study laid TM1 farther out (0.881 m) and framed it completely; this layout is a test
+    // set-up, not the study's.
     let mut cell = Cell::load("study-abb").unwrap();
     cell.set_offset_x("0.531").unwrap();
     cell.arrangement = framewright::cell::Arrangement::EndToEnd;
@@ -44,13 +46,19 @@ fn tm1_bottom_plate_out_of_range_is_one_cause_with_its_four_nails() {
     assert_eq!(
         not_placed.len(),
         1,
-        "the study's finding: TM1's bottom plate is not placed"
+        "laid at 0.531 m, TM1's bottom plate alone is not placed"
     );
     let causes = root_causes(&report, &report.walls[0].wall_id);
     assert_eq!(causes.len(), 1, "{causes:#?}");
     assert_eq!(&causes[0].piece, not_placed[0]);
     assert_eq!(causes[0].stage, "framing");
-    assert!(causes[0].message.contains("joint"), "{}", causes[0].message);
+    assert!(
+        causes[0].message.contains("joint limit"),
+        "{}",
+        causes[0].message
+    );
+    let role = &sim.plan.roles[not_placed[0].as_str()];
+    assert_eq!(role, "bottom_plate");
     // The executor skipped exactly the nails into the unplaced plate.
     let skipped = rec
         .nails

@@ -3,6 +3,8 @@
 //! executor's own tool poses, hostile names, byte-identical repeats. Tests that need a tool
 //! skip with a message when it is absent; `.ci/run` installs both.
 
+mod common;
+
 use framewright::cell::Cell;
 use framewright::ifc::Model;
 use framewright::report::html::{ReportInput, report_files, write_report};
@@ -85,7 +87,7 @@ fn chromium() -> Option<&'static str> {
             return Some(c);
         }
     }
-    eprintln!("skipped: no chromium on PATH (apt-get install chromium)");
+    common::skip::missing_tool("chromium", "apt-get install chromium");
     None
 }
 
@@ -141,30 +143,19 @@ fn console_errors(log: &str) -> Vec<&str> {
     log.lines().filter(|l| l.contains("CONSOLE")).collect()
 }
 
-#[test]
-fn tm3_page_in_a_browser_shows_every_piece_with_its_verdict_and_every_nail() {
-    let Some(browser) = chromium() else { return };
-    let r = run(&root().join("examples/models/tm3.ifc"));
-    let dir = tempfile::tempdir().unwrap();
-    let report_dir = dir.path().join("report");
-    write(&r, &report_dir);
-    let shot = output_dir().join("tm3-index.png");
-    let (dom, log) = browse(browser, &report_dir.join("index.html"), &shot);
-    assert!(console_errors(&log).is_empty(), "{log}");
-    eprintln!("screenshot: {}", shot.display());
-
-    // The JSON beside the page is the truth the drawing must show.
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(report_dir.join("simulate.json")).unwrap()).unwrap();
+/// Each wall's elevation in `page` (the written HTML, or the DOM a browser built from it) shows
+/// every piece of the wall once with the class of its verdicts in `json` (`simulate.json`), and
+/// one dot per nailing target.
+fn assert_elevations_show_the_verdicts(dom: &str, json: &serde_json::Value, walls: usize) {
     let section = Regex::new(r#"<section class="wall" id="[^"]*" data-wall="([^"]+)">"#).unwrap();
     let piece =
         Regex::new(r#"<g class="piece ([a-z-]+)" data-id="([^"]+)" data-guid="([^"]+)""#).unwrap();
     let nail = Regex::new(r#"<circle class="nail (driven|failed)""#).unwrap();
     let starts: Vec<(usize, String)> = section
-        .captures_iter(&dom)
+        .captures_iter(dom)
         .map(|c| (c.get(0).unwrap().start(), c[1].to_string()))
         .collect();
-    assert_eq!(starts.len(), r.report.walls.len(), "one section per wall");
+    assert_eq!(starts.len(), walls, "one section per wall");
     for (k, (start, wall)) in starts.iter().enumerate() {
         let end = starts.get(k + 1).map_or(dom.len(), |s| s.0);
         let text = &dom[*start..end];
@@ -209,6 +200,40 @@ fn tm3_page_in_a_browser_shows_every_piece_with_its_verdict_and_every_nail() {
             "{wall}: one dot per nail"
         );
     }
+}
+
+/// The page's static mapping (verdict to class, nail to dot) holds in the HTML as written, so
+/// it is checked where no browser is installed.
+#[test]
+fn tm3_page_as_written_shows_every_piece_with_its_verdict_and_every_nail() {
+    let r = run(&root().join("examples/models/tm3.ifc"));
+    let files = files(&r);
+    let page = String::from_utf8(files["index.html"].clone()).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&files["simulate.json"]).unwrap();
+    assert_elevations_show_the_verdicts(&page, &json, r.report.walls.len());
+    // Not every piece is framed: the drawing's classes are told apart.
+    for class in ["class=\"piece framed\"", "class=\"piece framing-failed\""] {
+        assert!(page.contains(class), "{class}");
+    }
+    assert!(page.contains("beyond reach"));
+}
+
+#[test]
+fn tm3_page_in_a_browser_shows_every_piece_with_its_verdict_and_every_nail() {
+    let Some(browser) = chromium() else { return };
+    let r = run(&root().join("examples/models/tm3.ifc"));
+    let dir = tempfile::tempdir().unwrap();
+    let report_dir = dir.path().join("report");
+    write(&r, &report_dir);
+    let shot = output_dir().join("tm3-index.png");
+    let (dom, log) = browse(browser, &report_dir.join("index.html"), &shot);
+    assert!(console_errors(&log).is_empty(), "{log}");
+    eprintln!("screenshot: {}", shot.display());
+
+    // The JSON beside the page is the truth the drawing must show.
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report_dir.join("simulate.json")).unwrap()).unwrap();
+    assert_elevations_show_the_verdicts(&dom, &json, r.report.walls.len());
     // The study's finding is on the page: the ends of TM3's long walls are out of reach.
     assert!(dom.contains("beyond reach"));
     assert!(dom.contains("consequences</summary>"));
@@ -252,10 +277,13 @@ fn hostile_names_render_as_text_and_nothing_executes() {
 
 /// Runs the Khronos validator (npm gltf-validator) on a GLB: its report as JSON.
 fn validate(glb: &Path) -> Option<serde_json::Value> {
-    let npm_root = Command::new("npm").args(["root", "-g"]).output().ok()?;
+    let Ok(npm_root) = Command::new("npm").args(["root", "-g"]).output() else {
+        common::skip::missing_tool("npm (for the glTF validator)", "apt-get install npm");
+        return None;
+    };
     let npm_root = String::from_utf8_lossy(&npm_root.stdout).trim().to_string();
     if !Path::new(&npm_root).join("gltf-validator").exists() {
-        eprintln!("skipped: npm gltf-validator is not installed (npm i -g gltf-validator)");
+        common::skip::missing_tool("the glTF validator", "npm install -g gltf-validator");
         return None;
     }
     let script = "const v = require('gltf-validator'); const fs = require('fs');\

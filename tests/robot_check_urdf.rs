@@ -1,5 +1,7 @@
 //! The shipped URDFs pass `check_urdf` (Debian package liburdfdom-tools; `.ci/run` installs it).
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -7,7 +9,7 @@ use std::process::Command;
 fn check_urdf_accepts_both_robots() {
     let probe = Command::new("check_urdf").output();
     if probe.is_err() {
-        eprintln!("skip: check_urdf not on PATH (apt-get install liburdfdom-tools)");
+        common::skip::missing_tool("check_urdf", "apt-get install liburdfdom-tools");
         return;
     }
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("robots");

@@ -2,6 +2,8 @@
 //! renamed over the model, then truncate-and-write in place), read its JSON events, save half
 //! a file, and end it with Ctrl-C (SIGINT).
 
+mod common;
+
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -39,7 +41,10 @@ fn next_event(rx: &mpsc::Receiver<String>, want: &str) -> serde_json::Value {
 #[test]
 fn watch_redoes_changed_walls_on_saves_and_keeps_the_last_result_on_a_torn_save() {
     if !Path::new("/bin/kill").exists() && !Path::new("/usr/bin/kill").exists() {
-        eprintln!("skipped: no kill command to send Ctrl-C");
+        common::skip::missing_tool(
+            "the kill command (to send Ctrl-C)",
+            "apt-get install procps",
+        );
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -1,9 +1,7 @@
-//! `why` on the study's TM3 top plate on the ABB cell. Until the executor
-//! runs inside these tests, the simulation facts it would record for that
-//! plate (its place pose is beyond the arm's reach) are inserted by hand:
-//! the test checks the explanation machinery (verdict rules, provenance down
-//! to IFC entities and cell keys), not the simulation. The numbers stand in
-//! for the executor's (distance of the wrist centre and the arm's reach).
+//! `why` on the study's TM3 top plate on the ABB cell, laid where the study laid TM3: the
+//! executor simulates the wall, and the explanation of the plate's failure goes from the
+//! verdict rule down to the executor's fact, the IFC entities and the cell keys. The numbers
+//! in it are checked against the arm's own kinematic chain and the plate's place.
 
 use framewright::cell::Cell;
 use framewright::frame::{Facts, RuleEngine, cell_facts, model_facts};
@@ -11,74 +9,41 @@ use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::logic::provenance::{How, Premise};
 use framewright::logic::{Explanation, Origin, Value};
+use framewright::sim::{SimOptions, simulate_wall_facts};
 use framewright::user_rules::render::render_why;
 use framewright::user_rules::why::{Context, WhyReport, why};
+use nalgebra::Vector3;
 use std::path::Path;
 
-/// The shipped cell as the study laid its TM3 (bottom plate 0.531 m from the base) with
-/// lumber end to end on conveyor 1: the fixed layout these tests were written against.
+mod common;
+use common::arm::Arm;
+
+/// The shipped cell with the walls laid where the study laid its TM3 (bottom plate 0.531 m
+/// from the base). (With lumber end to end on conveyor 1, the layout these tests were first
+/// written for, the 6.86 m top plate topples at the belt's end stop before the arm gets to it.)
 fn pinned(mut cell: Cell) -> Cell {
     cell.set_offset_x("0.531").unwrap();
-    cell.arrangement = framewright::cell::Arrangement::EndToEnd;
     cell
 }
 
 /// The W1 top plate of TM3 (entity #174, its box from representation item #171).
 const TOP_PLATE: &str = "#174";
-const DISTANCE: f64 = 2.987;
-const REACH: f64 = 2.552;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The model's and the cell's facts, and with `sim` the executor's facts of wall W1.
 fn facts(model: &Model, sim: bool) -> Facts {
     let cell = pinned(Cell::load("study-abb").unwrap());
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(&cell));
     if sim {
-        let p = model
-            .pieces()
-            .iter()
-            .find(|p| p.entity == 174)
-            .unwrap()
-            .id
-            .clone();
-        let s = Value::sym;
-        let ev = |e: &str| Origin::Event(e.to_string());
-        facts.add(
-            "sim_operation",
-            vec![s(&p), s("feed"), Value::float(0.0), Value::float(4.0)],
-            ev("feed"),
-        );
-        facts.add(
-            "sim_operation",
-            vec![s(&p), s("pick"), Value::float(4.0), Value::float(6.5)],
-            ev("pick"),
-        );
-        facts.add(
-            "sim_operation",
-            vec![s(&p), s("place"), Value::float(6.5), Value::float(6.5)],
-            ev("place"),
-        );
-        facts.add(
-            "sim_ik_solved",
-            vec![s(&p), s("pick"), Value::float(0.31)],
-            ev("pick"),
-        );
-        facts.add(
-            "sim_ik_failed",
-            vec![
-                s(&p),
-                s("place"),
-                s("out_of_reach"),
-                s(""),
-                Value::float(DISTANCE),
-                Value::float(REACH),
-                s("wrist centre beyond reach"),
-            ],
-            ev("place at t = 6.50 s"),
-        );
+        let options = SimOptions {
+            walls: vec!["W1".to_string()],
+            ..SimOptions::default()
+        };
+        facts.extend(simulate_wall_facts(model, &cell, &options).expect("W1 simulates"));
     }
     facts
 }
@@ -115,6 +80,48 @@ fn nodes<'a>(e: &'a Explanation, out: &mut Vec<&'a Explanation>) {
     }
 }
 
+/// "the wrist centre would be D m from the shoulder, the arm reaches R m (N mm too far)": R is
+/// the stretched arm's reach; D is where the wrist centre is with the tool straight down on
+/// the plate's top face, gripped somewhere along it (between its middle, the nearest, and as
+/// far out as both grippers stay on it); and even gripped in the middle the plate is too far.
+fn assert_the_numbers_are_the_arm_s(message: &str) {
+    let numbers = regex::Regex::new(
+        r"the wrist centre would be ([0-9.]+) m from the shoulder, the arm reaches ([0-9.]+) m \((\d+) mm too far\)",
+    )
+    .unwrap();
+    let c = numbers
+        .captures(message)
+        .unwrap_or_else(|| panic!("{message}"));
+    let [distance, reach, too_far] = [1, 2, 3].map(|i| c[i].parse::<f64>().unwrap());
+    let cell = pinned(Cell::load("study-abb").unwrap());
+    let arm = Arm::of(&cell);
+    assert!(
+        (reach - arm.reach).abs() < 0.001,
+        "{message}: the arm reaches {}",
+        arm.reach
+    );
+    // The plate: 6.858 m long, on edge (2x4: 89 mm up), its middle 2.940825 m out on the
+    // robot's x axis (0.531 m + the wall's height less half the plate: see
+    // `without_simulation_the_plate_has_only_plan_verdicts`).
+    let grip_z = cell.tool.tcps["grip"].translation.z;
+    let spacing = cell.tool.gripper.as_ref().unwrap().spacing;
+    let at =
+        |along: f64| arm.wrist_distance_tool_down(&Vector3::new(2.940825, along, 0.0889), grip_z);
+    let (nearest, farthest) = (at(0.0), at(6.858 / 2.0 - spacing / 2.0 - 0.05));
+    assert!(
+        nearest > arm.reach + 0.3,
+        "gripped in the middle: {nearest} m"
+    );
+    assert!(
+        distance >= nearest - 0.001 && distance <= farthest + 0.001,
+        "{message}: {nearest}..{farthest} m"
+    );
+    assert!(
+        ((distance - reach) * 1000.0 - too_far).abs() <= 1.0,
+        "{message}"
+    );
+}
+
 #[test]
 fn the_top_plate_failed_framing_because_its_place_pose_is_beyond_reach() {
     let (reports, _) = explain(true);
@@ -130,10 +137,7 @@ fn the_top_plate_failed_framing_because_its_place_pose_is_beyond_reach() {
     let msg = reason.tuple[3].as_symbol().unwrap();
     assert_eq!(reason.tuple[1].as_symbol(), Some("framing"));
     assert_eq!(reason.tuple[2].as_symbol(), Some("Robot"));
-    assert!(
-        msg.contains("2.987 m from the shoulder, the arm reaches 2.552 m (435 mm too far)"),
-        "{msg}"
-    );
+    assert_the_numbers_are_the_arm_s(msg);
     let rule = format!(
         "framing_place_beyond_reach (rules/verdicts.dl:{})",
         rule_line("rules/verdicts.dl", "framing_place_beyond_reach")
@@ -199,7 +203,9 @@ fn the_top_plate_failed_framing_because_its_place_pose_is_beyond_reach() {
     nodes(&reason.explanation, &mut all);
     let sim = all.iter().find(|n| n.relation == "sim_ik_failed").unwrap();
     assert!(
-        matches!(&sim.how, How::Input { origin: Origin::Event(e) } if e == "place at t = 6.50 s")
+        matches!(&sim.how, How::Input { origin: Origin::Event(e) } if e.ends_with("IK for place of 32H5oapRpM57uELNCcVku8")),
+        "{:?}",
+        sim.how
     );
     // The framing status is failed, and so the wall's framing stage.
     let status = r
@@ -216,8 +222,30 @@ fn the_text_tree_shows_the_numbers_the_rules_and_the_ifc_ids() {
     let text = render_why(&reports);
     assert!(text.starts_with("32H5oapRpM57uELNCcVku8 '2x4 top plate F-020' (IfcBeam #174, GlobalId 32H5oapRpM57uELNCcVku8), wall "), "{text}");
     let first = text.lines().nth(2).unwrap();
-    assert!(first.starts_with("element_reason(\"32H5oapRpM57uELNCcVku8\", \"framing\", \"Robot\", \"place pose beyond reach: the wrist centre would be 2.987 m from the shoulder, the arm reaches 2.552 m (435 mm too far)\")  [by framing_place_beyond_reach (rules/verdicts.dl:"), "{first}");
-    assert!(text.contains("sim_ik_failed(\"32H5oapRpM57uELNCcVku8\", \"place\", \"out_of_reach\", \"\", 2.987, 2.552, \"wrist centre beyond reach\")  [simulation: place at t = 6.50 s]"), "{text}");
+    let reason = reports[0]
+        .verdicts
+        .iter()
+        .find(|v| v.relation == "element_reason")
+        .unwrap();
+    let message = reason.tuple[3].as_symbol().unwrap();
+    assert!(
+        message.starts_with("place pose beyond reach: "),
+        "{message}"
+    );
+    assert!(first.starts_with(&format!("element_reason(\"32H5oapRpM57uELNCcVku8\", \"framing\", \"Robot\", \"{message}\")  [by framing_place_beyond_reach (rules/verdicts.dl:")), "{first}");
+    // The executor's fact with its two numbers as the message rounds them, and its event.
+    let fact = regex::Regex::new(
+        r#"sim_ik_failed\("32H5oapRpM57uELNCcVku8", "place", "out_of_reach", "", ([0-9.]+), ([0-9.]+), "out of reach: [^"]*"\)  \[simulation: [^\]]* IK for place of 32H5oapRpM57uELNCcVku8\]"#,
+    )
+    .unwrap();
+    let c = fact.captures(&text).unwrap_or_else(|| panic!("{text}"));
+    for (i, said) in [(1, "would be "), (2, "the arm reaches ")] {
+        let value: f64 = c[i].parse().unwrap();
+        assert!(
+            message.contains(&format!("{said}{value:.3} m")),
+            "{message} / {value}"
+        );
+    }
     assert!(
         text.contains("cell_value(\"assembly_offset_x\", 0.531)  [cell "),
         "{text}"
@@ -250,13 +278,7 @@ fn without_simulation_the_plate_has_only_plan_verdicts() {
         .collect();
     assert_eq!(
         rels,
-        [
-            "role",
-            "wall_of",
-            "assembly_rank",
-            "framing_target",
-            "spawn_beyond_belt"
-        ]
+        ["role", "wall_of", "assembly_rank", "framing_target",]
     );
     let target = &reports[0].verdicts[3];
     // The framing target lies 2.94 m out along the robot's x axis: the reach problem's cause.

@@ -310,7 +310,7 @@ fn shared_test_cases_build_scenes() {
     ] {
         let path = dir.join(name);
         if !path.is_file() {
-            eprintln!("skipped: {} is absent", path.display());
+            common::skip::missing_data(&path);
             continue;
         }
         let s = Scene::from_model_file(&path, &cell).unwrap();

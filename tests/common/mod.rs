@@ -3,8 +3,10 @@
 //! Python oracles.
 #![allow(dead_code)]
 
+pub mod arm;
 pub mod bcf;
 pub mod python;
+pub mod skip;
 
 use std::path::{Path, PathBuf};
 
@@ -16,7 +18,7 @@ pub fn shared_path(relative: &str) -> Option<PathBuf> {
     if path.exists() {
         Some(path)
     } else {
-        eprintln!("skipped: {} is absent", path.display());
+        skip::missing_data(&path);
         None
     }
 }

@@ -1,5 +1,6 @@
 //! Python oracles (IfcOpenShell, IfcOpenShell's BCF reader, xmlschema): a test uses them when
-//! installed and skips, saying what to install, when not. `.ci/run` installs them.
+//! installed and skips, saying what to install, when not (a failure under
+//! `FRAMEWRIGHT_REQUIRE_ORACLES`, which `.ci/run` sets after installing them).
 #![allow(dead_code)]
 
 use std::process::Command;
@@ -17,9 +18,9 @@ pub fn python_with(modules: &[&str], packages: &str) -> Option<&'static str> {
         .output()
         .is_ok_and(|o| o.status.success());
     if !ok {
-        eprintln!(
-            "skipped: python3 with {} is absent (pip install {packages})",
-            modules.join(", ")
+        super::skip::missing_tool(
+            &format!("python3 with {}", modules.join(", ")),
+            &format!("python3 -m pip install {packages}"),
         );
     }
     ok.then_some("python3")

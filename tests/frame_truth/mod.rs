@@ -3,6 +3,9 @@
 //! rule base's relations over them.
 #![allow(dead_code)]
 
+#[path = "../common/skip.rs"]
+mod skip;
+
 use framewright::frame::{Reasoned, RuleEngine, model_facts, reason};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
@@ -49,7 +52,7 @@ fn cases_in(files: Vec<PathBuf>) -> Vec<Case> {
 pub fn shared_cases() -> Option<Vec<Case>> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/ifc-testcases");
     if !dir.is_dir() {
-        eprintln!("skipped: {} is absent", dir.display());
+        skip::missing_data(&dir);
         return None;
     }
     Some(cases_in(truth_files(&dir)))
