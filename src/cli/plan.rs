@@ -1,5 +1,6 @@
-//! `framewright plan MODEL.ifc [--cell C] [--json] [--cache DIR | --no-cache]`: walls, roles,
-//! assembly order, nailing and framing targets. The built-in rules' results are cached per
+//! `framewright plan MODEL.ifc [--cell C] [--json] [--cache DIR | --no-cache] [--truth FILE]`:
+//! walls, roles, assembly order, nailing and framing targets; with `--truth`, each role's
+//! precision and recall against a hand-labelled file. The built-in rules' results are cached per
 //! independent part of the model, so a plan after a small edit reasons only what changed.
 
 use super::cache::{CacheArgs, warn_if_unwritable};
@@ -10,6 +11,7 @@ use framewright::frame::RuleLimits;
 use framewright::frame::placement::reason_placed;
 use framewright::frame::plan::Plan;
 use framewright::report::plan::PlanReport;
+use framewright::report::role_check::{RoleCheck, Truth};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -25,10 +27,16 @@ pub struct PlanArgs {
     /// --rules-dir).
     #[command(flatten)]
     pub cache: CacheArgs,
+    /// A hand-labelled truth file (JSON `{"members": [{"id", "role"}, …]}`, e.g. a `synth
+    /// --truth` sidecar): also print each role's precision and recall against it.
+    #[arg(long, value_name = "FILE")]
+    pub truth: Option<PathBuf>,
 }
 
 pub fn run(args: PlanArgs) -> CmdResult {
     let inputs = &args.inputs;
+    // A bad truth file is refused before any work.
+    let truth = args.truth.as_deref().map(Truth::read).transpose()?;
     let (model, cell, facts) = load_model_facts(&args.model, inputs)?;
     let cache = match inputs.rules_dir {
         None => args.cache.open(),
@@ -51,8 +59,10 @@ pub fn run(args: PlanArgs) -> CmdResult {
             (reasoned, None, plan)
         }
     };
+    let role_check = truth.map(|t| RoleCheck::new(&t, &model, &plan));
     let mut report = PlanReport::new(&model, &plan);
     report.cache = counts;
+    report.role_check = role_check.as_ref();
     let written = if args.json {
         write_stdout(|out| report.write_json(&mut &mut *out))
     } else {

@@ -36,6 +36,8 @@ pub enum PlacementArg {
 pub enum HeaderArg {
     BuiltUp,
     Solid,
+    /// One flat piece of the wall's lumber between the king studs, no jack studs.
+    Flat,
 }
 
 #[derive(clap::Args)]
@@ -259,6 +261,7 @@ fn header_style(args: &SynthArgs) -> HeaderStyle {
     match args.geometry.header {
         HeaderArg::BuiltUp => HeaderStyle::BuiltUp,
         HeaderArg::Solid => HeaderStyle::Solid,
+        HeaderArg::Flat => HeaderStyle::Flat,
     }
 }
 

@@ -10,6 +10,7 @@ mod mesh;
 pub mod plan;
 pub mod png;
 mod pretty_json;
+pub mod role_check;
 pub mod simulate;
 pub mod svg;
 pub mod verdict;

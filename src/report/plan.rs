@@ -20,6 +20,9 @@ pub struct PlanReport<'a> {
     /// Walls reasoned and walls read from the cache (absent without a cache).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cache: Option<crate::cache::CacheCounts>,
+    /// The roles against a hand-labelled truth file (`plan --truth`; absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub role_check: Option<&'a super::role_check::RoleCheck>,
 }
 
 #[derive(Debug, Serialize)]
@@ -252,6 +255,7 @@ impl<'a> PlanReport<'a> {
             walls,
             warnings,
             cache: None,
+            role_check: None,
         }
     }
 
@@ -265,6 +269,7 @@ impl<'a> PlanReport<'a> {
             walls: Vec::new(),
             warnings: self.warnings.clone(),
             cache: self.cache,
+            role_check: self.role_check,
         };
         let members = Array {
             key: "members",
@@ -308,6 +313,9 @@ impl<'a> PlanReport<'a> {
         }
         for warning in &self.warnings {
             let _ = writeln!(out, "warning: {warning}");
+        }
+        if let Some(check) = self.role_check {
+            out.push_str(&check.to_text());
         }
         out
     }

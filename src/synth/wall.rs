@@ -20,6 +20,10 @@ pub enum HeaderStyle {
     BuiltUp,
     /// One solid piece as thick as the wall (e.g. a 4x10 in a 2x4 wall).
     Solid,
+    /// One piece of the wall's lumber laid flat across the opening between the king studs,
+    /// with no jack studs: the opening's head is carried by the kings (as Constructivity
+    /// frames its example wall).
+    Flat,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -229,26 +233,35 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
     }
 
     for o in &openings {
-        // King studs full height, jacks under the header.
+        // King studs full height, jacks under the header; a flat header has no jacks and
+        // its kings stand at the opening's edges.
+        let jacks = spec.header_style != HeaderStyle::Flat;
+        let (king_left, king_right) = if jacks {
+            (o.u0 - 2.0 * t, o.u1 + t)
+        } else {
+            (o.u0 - t, o.u1)
+        };
         standing.push(piece(
             Role::KingStud,
             "",
             nominal,
-            stud_box(o.u0 - 2.0 * t, t, stud_top),
+            stud_box(king_left, t, stud_top),
         ));
         standing.push(piece(
             Role::KingStud,
             "",
             nominal,
-            stud_box(o.u1 + t, t, stud_top),
+            stud_box(king_right, t, stud_top),
         ));
-        standing.push(piece(
-            Role::JackStud,
-            "",
-            nominal,
-            stud_box(o.u0 - t, t, o.v1),
-        ));
-        standing.push(piece(Role::JackStud, "", nominal, stud_box(o.u1, t, o.v1)));
+        if jacks {
+            standing.push(piece(
+                Role::JackStud,
+                "",
+                nominal,
+                stud_box(o.u0 - t, t, o.v1),
+            ));
+            standing.push(piece(Role::JackStud, "", nominal, stud_box(o.u1, t, o.v1)));
+        }
         // Cripples on the stud grid inside the rough opening.
         let inside: Vec<f64> = grid
             .iter()
@@ -276,9 +289,24 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             }
         }
         let h = o.header;
-        let hu = [o.u0 - t, o.u1 + t];
-        let hv = [o.v1, o.v1 + h.width];
+        let (hu, hv) = match spec.header_style {
+            HeaderStyle::Flat => ([o.u0, o.u1], [o.v1, o.v1 + t]),
+            _ => ([o.u0 - t, o.u1 + t], [o.v1, o.v1 + h.width]),
+        };
         let label = match spec.header_style {
+            HeaderStyle::Flat => {
+                spanning.push(piece(
+                    Role::Header,
+                    "flat",
+                    nominal,
+                    WallBox {
+                        u: hu,
+                        v: hv,
+                        w: full_w,
+                    },
+                ));
+                format!("{nominal} flat")
+            }
             HeaderStyle::Solid => {
                 let name = format!("{}x{}", (depth / INCH).ceil() as u32, &h.nominal[2..]);
                 spanning.push(piece(
@@ -442,11 +470,14 @@ fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, 
                 "make the opening taller",
             ));
         }
-        if v1 + header.width > stud_top + 1e-9 {
+        let (head_nominal, head_depth) = match spec.header_style {
+            HeaderStyle::Flat => (spec.lumber.nominal, t),
+            _ => (header.nominal, header.width),
+        };
+        if v1 + head_depth > stud_top + 1e-9 {
             return Err(err(
                 format!(
-                    "opening top {v1:.4} m plus a {} header ({:.4} m) is above the top plate at {stud_top:.4} m",
-                    header.nominal, header.width
+                    "opening top {v1:.4} m plus a {head_nominal} header ({head_depth:.4} m) is above the top plate at {stud_top:.4} m"
                 ),
                 "lower or shorten the opening, or make the wall taller",
             ));
