@@ -169,6 +169,7 @@ fn blocking_and_doubled_studs() {
         double_top_plate: true,
         header_style: HeaderStyle::BuiltUp,
         openings: vec![],
+        detail: Default::default(),
     };
     let mut layout = single_wall("blocking", "blocking and a doubled stud", &spec).unwrap();
     let wall = &mut layout.buildings[0].storeys[0].walls[0];

@@ -308,6 +308,99 @@ fn twelve_foot_wall(openings: Vec<OpeningSpec>, header_style: HeaderStyle) -> Wa
         double_top_plate: true,
         header_style,
         openings,
+        detail: Default::default(),
+    }
+}
+
+/// A sill from king to king carries the jack studs, a cripple under each; a blocking row fills
+/// every bay it crosses between uprights that cross it, touching both, and never enters an
+/// opening's framing; no two pieces overlap.
+#[test]
+fn king_to_king_sills_and_blocking_rows_fit_the_frame() {
+    use framewright::synth::wall::{FramingDetail, SillStyle};
+    let window = OpeningSpec {
+        kind: OpeningKind::Window { sill: inches(36.0) },
+        u: inches(60.0),
+        width: inches(48.0),
+        height: inches(48.0),
+    };
+    let door = OpeningSpec {
+        kind: OpeningKind::Door,
+        u: inches(20.0),
+        width: inches(32.0),
+        height: inches(82.5),
+    };
+    let mut spec = twelve_foot_wall(vec![door, window], HeaderStyle::BuiltUp);
+    spec.detail = FramingDetail {
+        sill: SillStyle::KingToKing,
+        blocking_rows: vec![inches(24.0), inches(48.0)],
+    };
+    let wall = frame_wall(
+        &spec,
+        framewright::synth::layout::WallFrame::upright(Vec3::zeros(), Vec3::x()),
+    )
+    .unwrap();
+    let of = |role: Role| -> Vec<&framewright::synth::Piece> {
+        wall.pieces.iter().filter(|p| p.role == role).collect()
+    };
+    let t = Lumber::L2X4.thickness;
+    let sill = of(Role::Sill)[0].wall_box;
+    let kings = of(Role::KingStud);
+    assert!(
+        kings
+            .iter()
+            .any(|k| (k.wall_box.u[1] - sill.u[0]).abs() < 1e-9)
+    );
+    assert!(
+        kings
+            .iter()
+            .any(|k| (k.wall_box.u[0] - sill.u[1]).abs() < 1e-9)
+    );
+    let jacks_on_sill: Vec<_> = of(Role::JackStud)
+        .into_iter()
+        .filter(|j| (j.wall_box.v[0] - sill.v[1]).abs() < 1e-9)
+        .collect();
+    assert_eq!(jacks_on_sill.len(), 2);
+    for j in &jacks_on_sill {
+        assert!(of(Role::CrippleStud).iter().any(|c| c.wall_box.u == j.wall_box.u
+            && (c.wall_box.v[1] - sill.v[0]).abs() < 1e-9));
+    }
+    let blocking = of(Role::Blocking);
+    assert!(!blocking.is_empty());
+    let uprights: Vec<_> = wall
+        .pieces
+        .iter()
+        .filter(|p| p.role.is_vertical())
+        .collect();
+    for b in &blocking {
+        let bb = b.wall_box;
+        assert!((bb.v[1] - bb.v[0] - t).abs() < 1e-9);
+        for end in [bb.u[0], bb.u[1]] {
+            assert!(
+                uprights.iter().any(|u| (u.wall_box.u[0] - end).abs() < 1e-9
+                    || (u.wall_box.u[1] - end).abs() < 1e-9),
+                "{bb:?}: an end meets no upright"
+            );
+        }
+    }
+    let overlap = |a: [f64; 2], b: [f64; 2]| a[0] < b[1] - 1e-9 && b[0] < a[1] - 1e-9;
+    for (i, a) in wall.pieces.iter().enumerate() {
+        for b in &wall.pieces[i + 1..] {
+            let (x, y) = (a.wall_box, b.wall_box);
+            assert!(
+                !(overlap(x.u, y.u) && overlap(x.v, y.v) && overlap(x.w, y.w)),
+                "{:?} {x:?} overlaps {:?} {y:?}",
+                a.role,
+                b.role
+            );
+        }
+    }
+    // Across the door and inside the window no row is blocked in.
+    for b in &blocking {
+        assert!(!overlap(b.wall_box.u, [inches(20.0), inches(52.0)]));
+        let in_window = overlap(b.wall_box.u, [inches(60.0), inches(108.0)])
+            && overlap(b.wall_box.v, [inches(35.0), inches(84.0)]);
+        assert!(!in_window, "{:?}", b.wall_box);
     }
 }
 

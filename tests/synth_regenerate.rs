@@ -72,5 +72,5 @@ fn example_models_are_what_their_readme_commands_write() {
 
 #[test]
 fn fixtures_are_what_their_readme_commands_write() {
-    regenerate_all("tests/fixtures/README.md", 5);
+    regenerate_all("tests/fixtures/README.md", 6);
 }

@@ -6,7 +6,9 @@ use framewright::synth::building::{
 use framewright::synth::layout::{Layout, Vec3};
 use framewright::synth::models;
 use framewright::synth::units::{Lumber, parse_length};
-use framewright::synth::wall::{HeaderStyle, OpeningKind, OpeningSpec, StudLayout, WallSpec};
+use framewright::synth::wall::{
+    FramingDetail, HeaderStyle, OpeningKind, OpeningSpec, SillStyle, StudLayout, WallSpec,
+};
 use framewright::synth::{
     Grouping, LengthUnit, PlacementBase, ProductClasses, Schema, SynthError, WriteOptions,
     write_ifc,
@@ -38,6 +40,14 @@ pub enum HeaderArg {
     Solid,
     /// One flat piece of the wall's lumber between the king studs, no jack studs.
     Flat,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum SillArg {
+    /// Between the jack studs, which run down to the bottom plate.
+    BetweenJacks,
+    /// From king stud to king stud, the jacks standing on it.
+    KingToKing,
 }
 
 #[derive(clap::Args)]
@@ -127,6 +137,13 @@ pub struct GeometryArgs {
     /// Header construction.
     #[arg(long, value_enum, default_value = "built-up")]
     pub header: HeaderArg,
+    /// For `wall`: how a window's rough sill meets its studs.
+    #[arg(long, value_enum, default_value = "between-jacks")]
+    pub sill: SillArg,
+    /// For `wall`: a row of flat blocking between the studs, its underside this high above
+    /// the floor (fire or mid-height blocking); repeatable.
+    #[arg(long, value_name = "HEIGHT")]
+    pub blocking: Vec<String>,
     /// For `building`: leave out the default door and windows.
     #[arg(long)]
     pub no_openings: bool,
@@ -321,6 +338,18 @@ fn wall_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
         double_top_plate: !args.geometry.single_top_plate,
         header_style: header_style(args),
         openings,
+        detail: FramingDetail {
+            sill: match args.geometry.sill {
+                SillArg::BetweenJacks => SillStyle::BetweenJacks,
+                SillArg::KingToKing => SillStyle::KingToKing,
+            },
+            blocking_rows: args
+                .geometry
+                .blocking
+                .iter()
+                .map(|h| parse_length(h.as_str()))
+                .collect::<Result<_, _>>()?,
+        },
     };
     models::single_wall("wall", "Parametric wood-frame wall", &spec)
 }

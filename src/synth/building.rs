@@ -80,6 +80,7 @@ fn frame_unit(
             studs: spec.studs,
             double_top_plate: spec.double_top_plate,
             header_style: spec.header_style,
+            detail: Default::default(),
             openings: spec.openings[k].clone(),
         };
         walls.push(frame_wall(&wall, frame)?);

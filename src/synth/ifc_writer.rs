@@ -149,14 +149,15 @@ struct ProductKind {
     predefined: &'static str,
 }
 
-fn product_kind(products: ProductClasses, piece_vertical: bool, is_header: bool) -> ProductKind {
+/// `is_member`: a lying piece that is not a plate (a header or blocking).
+fn product_kind(products: ProductClasses, piece_vertical: bool, is_member: bool) -> ProductKind {
     match (products, piece_vertical) {
         (ProductClasses::Member, true) => ProductKind {
             entity: "IFCMEMBER",
             ifc_type: "IfcMember",
             predefined: "STUD",
         },
-        (ProductClasses::Member, false) if is_header => ProductKind {
+        (ProductClasses::Member, false) if is_member => ProductKind {
             entity: "IFCMEMBER",
             ifc_type: "IfcMember",
             predefined: "MEMBER",
@@ -838,7 +839,10 @@ fn write_piece_products(
         let kind = product_kind(
             ctx.opts.products,
             vertical,
-            piece.role == crate::synth::Role::Header,
+            matches!(
+                piece.role,
+                crate::synth::Role::Header | crate::synth::Role::Blocking
+            ),
         );
         let lp = place.at(ctx, piece.start);
         // Vertical pieces extrude along the placement's z with default axes; the

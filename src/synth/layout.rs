@@ -15,6 +15,7 @@ pub enum Role {
     Header,
     Sill,
     CrippleStud,
+    Blocking,
 }
 
 impl Role {
@@ -29,6 +30,7 @@ impl Role {
             Role::Header => "header",
             Role::Sill => "sill",
             Role::CrippleStud => "cripple_stud",
+            Role::Blocking => "blocking",
         }
     }
 

@@ -42,6 +42,7 @@ fn end_stud_frame(id: &str, name: &str, length: f64, height: f64, lumber: Lumber
         studs: StudLayout::EndsOnly,
         double_top_plate: false,
         header_style: HeaderStyle::BuiltUp,
+        detail: Default::default(),
         openings: vec![],
     }
 }

@@ -26,6 +26,27 @@ pub enum HeaderStyle {
     Flat,
 }
 
+/// How a window's rough sill meets the opening's studs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SillStyle {
+    /// Between the jack studs, which run down to the bottom plate.
+    #[default]
+    BetweenJacks,
+    /// From king stud to king stud: the jack studs stand on it, and cripples (one under each
+    /// jack) carry it.
+    KingToKing,
+}
+
+/// Framing details beyond the studs on centre and the openings.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FramingDetail {
+    pub sill: SillStyle,
+    /// Rows of flat blocking between the uprights (fire or mid-height blocking): the height of
+    /// each row's underside above the floor (m). A row skips the bays an opening's framing
+    /// crosses.
+    pub blocking_rows: Vec<f64>,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum OpeningKind {
     Door,
@@ -66,6 +87,7 @@ pub struct WallSpec {
     pub double_top_plate: bool,
     pub header_style: HeaderStyle,
     pub openings: Vec<OpeningSpec>,
+    pub detail: FramingDetail,
 }
 
 // Limits that keep the generator inside what wall framing means; outside them the
@@ -163,6 +185,9 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
     }
     let len = spec.length;
     let stud_top = spec.height - (plates - 1.0) * t;
+    for &row in &spec.detail.blocking_rows {
+        check_range(spec, "blocking row height", row, t, stud_top - t)?;
+    }
     let openings = place_openings(spec, stud_top)?;
 
     let full_w = [0.0, depth];
@@ -253,14 +278,26 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             nominal,
             stud_box(king_right, t, stud_top),
         ));
+        // A sill from king to king carries the jacks; one between them does not.
+        let sill_top = match o.spec.kind {
+            OpeningKind::Window { sill } => Some(sill),
+            OpeningKind::Door => None,
+        }
+        .filter(|_| jacks && spec.detail.sill == SillStyle::KingToKing);
         if jacks {
+            let jack_foot = sill_top.unwrap_or(t);
             standing.push(piece(
                 Role::JackStud,
                 "",
                 nominal,
-                stud_box(o.u0 - t, t, o.v1),
+                stud_box(o.u0 - t, jack_foot, o.v1),
             ));
-            standing.push(piece(Role::JackStud, "", nominal, stud_box(o.u1, t, o.v1)));
+            standing.push(piece(
+                Role::JackStud,
+                "",
+                nominal,
+                stud_box(o.u1, jack_foot, o.v1),
+            ));
         }
         // Cripples on the stud grid inside the rough opening.
         let inside: Vec<f64> = grid
@@ -269,16 +306,32 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             .filter(|&c| c - 0.5 * t >= o.u0 - 1e-9 && c + 0.5 * t <= o.u1 + 1e-9)
             .collect();
         if let OpeningKind::Window { sill } = o.spec.kind {
+            let sill_u = if sill_top.is_some() {
+                [o.u0 - t, o.u1 + t]
+            } else {
+                [o.u0, o.u1]
+            };
             spanning.push(piece(
                 Role::Sill,
                 "",
                 nominal,
                 WallBox {
-                    u: [o.u0, o.u1],
+                    u: sill_u,
                     v: [sill - t, sill],
                     w: full_w,
                 },
             ));
+            if sill_top.is_some() {
+                // Under each jack, a cripple carries the sill's end.
+                for u0 in [o.u0 - t, o.u1] {
+                    standing.push(piece(
+                        Role::CrippleStud,
+                        "below_sill",
+                        nominal,
+                        stud_box(u0, t, sill - t),
+                    ));
+                }
+            }
             for &c in &inside {
                 standing.push(piece(
                     Role::CrippleStud,
@@ -366,6 +419,47 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             rough_opening_v: [o.v0, o.v1],
             header: label,
         });
+    }
+
+    // Rows of flat blocking in the bays between uprights that cross the row, clear of every
+    // sill, header and rough opening.
+    for &row in &spec.detail.blocking_rows {
+        let band = [row, row + t];
+        let mut posts: Vec<[f64; 2]> = standing
+            .iter()
+            .chain(&above)
+            .map(|p| p.wall_box)
+            .filter(|b| b.v[0] <= band[0] + 1e-9 && b.v[1] >= band[1] - 1e-9)
+            .map(|b| b.u)
+            .collect();
+        posts.sort_by(|a, b| a[0].total_cmp(&b[0]));
+        let overlaps = |a: [f64; 2], b: [f64; 2]| a[0] < b[1] - 1e-9 && b[0] < a[1] - 1e-9;
+        let mut row_pieces = Vec::new();
+        for pair in posts.windows(2) {
+            let gap = [pair[0][1], pair[1][0]];
+            if gap[1] - gap[0] < MIN_CRIPPLE {
+                continue;
+            }
+            let crosses_framing = spanning
+                .iter()
+                .any(|s| overlaps(s.wall_box.u, gap) && overlaps(s.wall_box.v, band))
+                || openings
+                    .iter()
+                    .any(|o| overlaps([o.u0, o.u1], gap) && overlaps([o.v0, o.v1], band));
+            if !crosses_framing {
+                row_pieces.push(piece(
+                    Role::Blocking,
+                    "",
+                    nominal,
+                    WallBox {
+                        u: gap,
+                        v: band,
+                        w: full_w,
+                    },
+                ));
+            }
+        }
+        spanning.extend(row_pieces);
     }
 
     let by_u = |a: &Piece, b: &Piece| {
