@@ -334,6 +334,7 @@ fn king_to_king_sills_and_blocking_rows_fit_the_frame() {
     spec.detail = FramingDetail {
         sill: SillStyle::KingToKing,
         blocking_rows: vec![inches(24.0), inches(48.0)],
+        ..FramingDetail::default()
     };
     let wall = frame_wall(
         &spec,

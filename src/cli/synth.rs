@@ -140,6 +140,9 @@ pub struct GeometryArgs {
     /// For `wall`: how a window's rough sill meets its studs.
     #[arg(long, value_enum, default_value = "between-jacks")]
     pub sill: SillArg,
+    /// For `wall`: a double rough sill (two plies stacked) under every window.
+    #[arg(long)]
+    pub double_sill: bool,
     /// For `wall`: a row of flat blocking between the studs, its underside this high above
     /// the floor (fire or mid-height blocking); repeatable.
     #[arg(long, value_name = "HEIGHT")]
@@ -343,6 +346,7 @@ fn wall_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
                 SillArg::BetweenJacks => SillStyle::BetweenJacks,
                 SillArg::KingToKing => SillStyle::KingToKing,
             },
+            sill_plies: if args.geometry.double_sill { 2 } else { 1 },
             blocking_rows: args
                 .geometry
                 .blocking

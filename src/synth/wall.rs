@@ -38,13 +38,25 @@ pub enum SillStyle {
 }
 
 /// Framing details beyond the studs on centre and the openings.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FramingDetail {
     pub sill: SillStyle,
+    /// Plies of a window's rough sill, stacked (1 or 2).
+    pub sill_plies: u32,
     /// Rows of flat blocking between the uprights (fire or mid-height blocking): the height of
     /// each row's underside above the floor (m). A row skips the bays an opening's framing
     /// crosses.
     pub blocking_rows: Vec<f64>,
+}
+
+impl Default for FramingDetail {
+    fn default() -> Self {
+        FramingDetail {
+            sill: SillStyle::default(),
+            sill_plies: 1,
+            blocking_rows: Vec::new(),
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -188,6 +200,13 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
     for &row in &spec.detail.blocking_rows {
         check_range(spec, "blocking row height", row, t, stud_top - t)?;
     }
+    if !(1..=2).contains(&spec.detail.sill_plies) {
+        return Err(wall_err(
+            spec,
+            format!("{} sill plies", spec.detail.sill_plies),
+            "a rough sill is single or double (1 or 2 plies)",
+        ));
+    }
     let openings = place_openings(spec, stud_top)?;
 
     let full_w = [0.0, depth];
@@ -311,16 +330,27 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             } else {
                 [o.u0, o.u1]
             };
-            spanning.push(piece(
-                Role::Sill,
-                "",
-                nominal,
-                WallBox {
-                    u: sill_u,
-                    v: [sill - t, sill],
-                    w: full_w,
-                },
-            ));
+            // A double sill: the second ply under the first; the cripples stop under the lowest.
+            let plies = spec.detail.sill_plies as f64;
+            for k in 0..spec.detail.sill_plies {
+                let top = sill - k as f64 * t;
+                let detail = match (spec.detail.sill_plies, k) {
+                    (1, _) => "",
+                    (_, 0) => "upper ply",
+                    _ => "lower ply",
+                };
+                spanning.push(piece(
+                    Role::Sill,
+                    detail,
+                    nominal,
+                    WallBox {
+                        u: sill_u,
+                        v: [top - t, top],
+                        w: full_w,
+                    },
+                ));
+            }
+            let sill_bottom = sill - plies * t;
             if sill_top.is_some() {
                 // Under each jack, a cripple carries the sill's end.
                 for u0 in [o.u0 - t, o.u1] {
@@ -328,7 +358,7 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
                         Role::CrippleStud,
                         "below_sill",
                         nominal,
-                        stud_box(u0, t, sill - t),
+                        stud_box(u0, t, sill_bottom),
                     ));
                 }
             }
@@ -337,7 +367,7 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
                     Role::CrippleStud,
                     "below_sill",
                     nominal,
-                    stud_box(c - 0.5 * t, t, sill - t),
+                    stud_box(c - 0.5 * t, t, sill_bottom),
                 ));
             }
         }
@@ -437,7 +467,9 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         let mut row_pieces = Vec::new();
         for pair in posts.windows(2) {
             let gap = [pair[0][1], pair[1][0]];
-            if gap[1] - gap[0] < MIN_CRIPPLE {
+            // A bay narrower than the lumber is wide takes no block (it would lie across the
+            // wall, not along it).
+            if gap[1] - gap[0] < depth {
                 continue;
             }
             let crosses_framing = spanning
@@ -547,7 +579,8 @@ fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, 
         let (v0, v1) = match o.kind {
             OpeningKind::Door => (0.0, o.height),
             OpeningKind::Window { sill } => {
-                if !sill.is_finite() || sill - t < t + 0.05 {
+                let plies = spec.detail.sill_plies.max(1) as f64;
+                if !sill.is_finite() || sill - plies * t < t + 0.05 {
                     return Err(err(
                         format!(
                             "sill height {sill} m leaves no room for the rough sill and cripples below it"
