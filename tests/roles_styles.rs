@@ -1,9 +1,10 @@
 //! Roles over the framing styles `framewright synth wall` writes, against the truth sidecars it
 //! writes beside them: every header construction (built-up, solid, flat on the kings with no
 //! jacks), sills between the jacks or king to king under the jacks, single and double sills,
-//! rows of blocking, 2x4 and 2x6, with doors and windows at several places, written as
-//! IfcMember or IfcColumn/IfcBeam, one product per piece or mapped items. Per role, precision
-//! and recall over all of them must be at least 99.5 % (`plan --truth` computes them).
+//! rows of blocking, doubled king studs, double and triple top plates, 2x4 and 2x6, with doors
+//! and windows at several places, written as IfcMember or IfcColumn/IfcBeam, one product per
+//! piece or mapped items. Per role, precision and recall over all of them must be at least
+//! 99.5 % (`plan --truth` computes them).
 
 use std::collections::BTreeMap;
 use std::process::Command;
@@ -72,6 +73,14 @@ fn every_role_of_every_generated_style_is_found() {
                                 args.extend(["--mapped", "--grouping", "assembly", "--unit", "ft"])
                             }
                             _ => args.extend(["--single-top-plate", "--grouping", "wall"]),
+                        }
+                        // Doubled king studs on every third wall, a triple top plate on
+                        // every fifth (not on the single-top-plate ones).
+                        if case.is_multiple_of(3) {
+                            args.push("--double-kings");
+                        }
+                        if case.is_multiple_of(5) && !case.is_multiple_of(4) {
+                            args.push("--triple-top-plate");
                         }
                         let (ifc_s, truth_s) = (ifc.to_str().unwrap(), truth.to_str().unwrap());
                         args.extend(["-o", ifc_s, "--truth", truth_s]);

@@ -143,6 +143,12 @@ pub struct GeometryArgs {
     /// For `wall`: a double rough sill (two plies stacked) under every window.
     #[arg(long)]
     pub double_sill: bool,
+    /// For `wall`: every opening's king studs doubled.
+    #[arg(long)]
+    pub double_kings: bool,
+    /// For `wall`: a third top plate on the cap plate.
+    #[arg(long)]
+    pub triple_top_plate: bool,
     /// For `wall`: a row of flat blocking between the studs, its underside this high above
     /// the floor (fire or mid-height blocking); repeatable.
     #[arg(long, value_name = "HEIGHT")]
@@ -347,6 +353,8 @@ fn wall_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
                 SillArg::KingToKing => SillStyle::KingToKing,
             },
             sill_plies: if args.geometry.double_sill { 2 } else { 1 },
+            double_kings: args.geometry.double_kings,
+            extra_cap_plates: u32::from(args.geometry.triple_top_plate),
             blocking_rows: args
                 .geometry
                 .blocking

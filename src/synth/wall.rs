@@ -43,6 +43,10 @@ pub struct FramingDetail {
     pub sill: SillStyle,
     /// Plies of a window's rough sill, stacked (1 or 2).
     pub sill_plies: u32,
+    /// Each opening's king studs doubled: a second full-height stud outside each king.
+    pub double_kings: bool,
+    /// Plates stacked on the cap plate (a third top plate, …); with a cap plate only.
+    pub extra_cap_plates: u32,
     /// Rows of flat blocking between the uprights (fire or mid-height blocking): the height of
     /// each row's underside above the floor (m). A row skips the bays an opening's framing
     /// crosses.
@@ -54,6 +58,8 @@ impl Default for FramingDetail {
         FramingDetail {
             sill: SillStyle::default(),
             sill_plies: 1,
+            double_kings: false,
+            extra_cap_plates: 0,
             blocking_rows: Vec::new(),
         }
     }
@@ -161,12 +167,15 @@ struct PlacedOpening {
     /// Top of the rough opening = bottom of the header.
     v1: f64,
     header: Lumber,
+    /// Stud thicknesses of framing beside the rough opening on each side (2: jack and king;
+    /// 3 with doubled kings).
+    beside: f64,
 }
 
 impl PlacedOpening {
     /// Extent from the outer face of one king stud to the other.
     fn zone(&self, t: f64) -> [f64; 2] {
-        [self.u0 - 2.0 * t, self.u1 + 2.0 * t]
+        [self.u0 - self.beside * t, self.u1 + self.beside * t]
     }
 }
 
@@ -184,7 +193,25 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         MIN_LENGTH.max(3.0 * t),
         MAX_LENGTH,
     )?;
-    let plates = if spec.double_top_plate { 3.0 } else { 2.0 };
+    if spec.detail.extra_cap_plates > 0 && !spec.double_top_plate {
+        return Err(wall_err(
+            spec,
+            format!(
+                "{} plates on a cap plate, but the wall has none",
+                spec.detail.extra_cap_plates
+            ),
+            "extra cap plates need the double top plate",
+        ));
+    }
+    if spec.detail.extra_cap_plates > 1 {
+        return Err(wall_err(
+            spec,
+            format!("{} plates on the cap plate", spec.detail.extra_cap_plates),
+            "a wall has at most a triple top plate",
+        ));
+    }
+    let plates =
+        if spec.double_top_plate { 3.0 } else { 2.0 } + spec.detail.extra_cap_plates as f64;
     check_range(
         spec,
         "height",
@@ -297,6 +324,19 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             nominal,
             stud_box(king_right, t, stud_top),
         ));
+        // A king doubled: geometry cannot tell it from a common stud that happens to stand
+        // against the king (both run plate to plate, face to face with it), so it is labelled
+        // what its geometry says, a stud; only the king meets the jack or the header's end.
+        if spec.detail.double_kings {
+            for u0 in [king_left - t, king_right + t] {
+                standing.push(piece(
+                    Role::Stud,
+                    "doubles the king stud",
+                    nominal,
+                    stud_box(u0, t, stud_top),
+                ));
+            }
+        }
         // A sill from king to king carries the jacks; one between them does not.
         let sill_top = match o.spec.kind {
             OpeningKind::Window { sill } => Some(sill),
@@ -517,16 +557,19 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         },
     ));
     if spec.double_top_plate {
-        pieces.push(piece(
-            Role::CapPlate,
-            "",
-            nominal,
-            WallBox {
-                u: [0.0, len],
-                v: [stud_top + t, stud_top + 2.0 * t],
-                w: full_w,
-            },
-        ));
+        for k in 0..=spec.detail.extra_cap_plates {
+            let v0 = stud_top + (1 + k) as f64 * t;
+            pieces.push(piece(
+                Role::CapPlate,
+                if k == 0 { "" } else { "third plate" },
+                nominal,
+                WallBox {
+                    u: [0.0, len],
+                    v: [v0, v0 + t],
+                    w: full_w,
+                },
+            ));
+        }
     }
     Ok(WallLayout {
         id: spec.id.clone(),
@@ -561,7 +604,8 @@ fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, 
             }
         }
         let (u0, u1) = (o.u, o.u + o.width);
-        if u0 - 2.0 * t < t - 1e-9 || u1 + 2.0 * t > spec.length - t + 1e-9 {
+        let beside = if spec.detail.double_kings { 3.0 } else { 2.0 };
+        if u0 - beside * t < t - 1e-9 || u1 + beside * t > spec.length - t + 1e-9 {
             return Err(err(
                 format!(
                     "rough opening u {u0:.4}..{u1:.4} m with its jack and king studs does not fit between the end studs of a {:.4} m wall",
@@ -617,6 +661,7 @@ fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, 
             v0,
             v1,
             header,
+            beside,
         });
     }
     placed.sort_by(|a, b| a.u0.total_cmp(&b.u0));
