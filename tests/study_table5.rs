@@ -154,6 +154,19 @@ fn unframed(r: &Run, i: usize) -> Vec<(&str, &str)> {
         .collect()
 }
 
+/// Every TM3 row of Table 5 (lines "3 L", "3 R", "3 F", "3 B"): feeding Completed, framing
+/// and nailing Partial, the robot at fault for the framing. The study names the robot for the
+/// nailing too: its nailing stopped at the bottom plate's nails to the inner studs (no IK
+/// solution). The shipped cells lay each wall where the arm reaches the most of its nails, so
+/// the nails left out are those into pieces not framed, and the component named is the framing.
+fn assert_tm3_row(row: &WallRow, context: &str, text: &str) {
+    assert_eq!(row.material_feeding, "Completed", "{context}: {text}");
+    assert_eq!(row.framing.status, "Partial", "{context}: {text}");
+    assert_eq!(row.framing.failed_component, "Robot", "{context}");
+    assert_eq!(row.nailing.status, "Partial", "{context}: {text}");
+    assert_eq!(row.nailing.failed_component, "Framing", "{context}");
+}
+
 #[test]
 fn tm3_short_walls_are_partial_on_the_plates_above_only_in_the_study_s_time() {
     // Table 5, lines "3 L" and "3 R": feeding Completed; framing Partial (Robot), 4.53 and 4.50
@@ -165,15 +178,7 @@ fn tm3_short_walls_are_partial_on_the_plates_above_only_in_the_study_s_time() {
         for (i, minutes) in short.into_iter().zip([TM3_L_FRAMING, TM3_R_FRAMING]) {
             let row = &r.report.walls[i];
             let context = format!("TM3 {} on {cell}", row.name);
-            assert_eq!(row.material_feeding, "Completed", "{context}: {text}");
-            assert_eq!(row.framing.status, "Partial", "{context}: {text}");
-            assert_eq!(row.framing.failed_component, "Robot", "{context}");
-            assert_eq!(row.nailing.status, "Partial", "{context}: {text}");
-            // The study names the robot for the nailing too: its nailing stopped at the bottom
-            // plate's nails to the inner studs (no IK solution). The shipped cells lay each wall
-            // where the arm reaches the most of its nails, so the nails left out are those into
-            // the plates that were not framed, and the component named is the framing.
-            assert_eq!(row.nailing.failed_component, "Framing", "{context}");
+            assert_tm3_row(row, &context, &text);
             // The plates above the studs, and nothing else. (The bundled TM3 has a cap plate
             // over its top plate; the study's has none.)
             let roles: Vec<&str> = unframed(&r, i).into_iter().map(|(_, role)| role).collect();
@@ -205,34 +210,28 @@ fn tm3_long_walls_fail_at_each_end_the_studs_the_geometry_puts_beyond_reach() {
     // when, gripped anywhere along it with both grippers on the lumber and the tool straight
     // down at its place pose or the pose above it, the wrist centre stays farther from the
     // shoulder than the stretched arm reaches.
+    let model =
+        Model::open(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc")).unwrap();
+    let length: BTreeMap<&str, f64> = model
+        .pieces()
+        .iter()
+        .map(|p| {
+            let (a, b) = p.axis();
+            (p.id.as_str(), (b - a).norm())
+        })
+        .collect();
     for cell_name in CELLS {
         let cell = Cell::load(cell_name).unwrap();
         let arm = Arm::of(&cell);
         let grip_z = cell.tool.tcps["grip"].translation.z;
         let spacing = cell.tool.gripper.as_ref().unwrap().spacing;
-        let model =
-            Model::open(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc"))
-                .unwrap();
-        let length: BTreeMap<&str, f64> = model
-            .pieces()
-            .iter()
-            .map(|p| {
-                let (a, b) = p.axis();
-                (p.id.as_str(), (b - a).norm())
-            })
-            .collect();
         let r = run("tm3.ifc", cell_name);
         let text = r.report.to_text();
         let (_, long) = tm3_walls(&r);
         for i in long {
             let row = &r.report.walls[i];
             let context = format!("TM3 {} on {cell_name}", row.name);
-            assert_eq!(row.material_feeding, "Completed", "{context}");
-            assert_eq!(row.framing.status, "Partial", "{context}: {text}");
-            assert_eq!(row.framing.failed_component, "Robot", "{context}");
-            assert_eq!(row.nailing.status, "Partial", "{context}");
-            // As on the short walls: the nails left out are those into pieces not framed.
-            assert_eq!(row.nailing.failed_component, "Framing", "{context}");
+            assert_tm3_row(row, &context, &text);
             let wall = &r.plan.walls[i];
             let failed: Vec<&str> = unframed(&r, i).into_iter().map(|(id, _)| id).collect();
             // The wall's direction in the cell: its bottom plate's axis.

@@ -352,9 +352,9 @@ fn wall_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
                 SillArg::BetweenJacks => SillStyle::BetweenJacks,
                 SillArg::KingToKing => SillStyle::KingToKing,
             },
-            sill_plies: if args.geometry.double_sill { 2 } else { 1 },
+            double_sill: args.geometry.double_sill,
             double_kings: args.geometry.double_kings,
-            extra_cap_plates: u32::from(args.geometry.triple_top_plate),
+            triple_top_plate: args.geometry.triple_top_plate,
             blocking_rows: args
                 .geometry
                 .blocking

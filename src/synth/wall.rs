@@ -38,31 +38,19 @@ pub enum SillStyle {
 }
 
 /// Framing details beyond the studs on centre and the openings.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct FramingDetail {
     pub sill: SillStyle,
-    /// Plies of a window's rough sill, stacked (1 or 2).
-    pub sill_plies: u32,
+    /// A double rough sill: two plies stacked under every window.
+    pub double_sill: bool,
     /// Each opening's king studs doubled: a second full-height stud outside each king.
     pub double_kings: bool,
-    /// Plates stacked on the cap plate (a third top plate, …); with a cap plate only.
-    pub extra_cap_plates: u32,
+    /// A third top plate on the cap plate (with a cap plate only).
+    pub triple_top_plate: bool,
     /// Rows of flat blocking between the uprights (fire or mid-height blocking): the height of
     /// each row's underside above the floor (m). A row skips the bays an opening's framing
     /// crosses.
     pub blocking_rows: Vec<f64>,
-}
-
-impl Default for FramingDetail {
-    fn default() -> Self {
-        FramingDetail {
-            sill: SillStyle::default(),
-            sill_plies: 1,
-            double_kings: false,
-            extra_cap_plates: 0,
-            blocking_rows: Vec::new(),
-        }
-    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -193,25 +181,19 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         MIN_LENGTH.max(3.0 * t),
         MAX_LENGTH,
     )?;
-    if spec.detail.extra_cap_plates > 0 && !spec.double_top_plate {
+    if spec.detail.triple_top_plate && !spec.double_top_plate {
         return Err(wall_err(
             spec,
-            format!(
-                "{} plates on a cap plate, but the wall has none",
-                spec.detail.extra_cap_plates
-            ),
-            "extra cap plates need the double top plate",
+            "a third top plate, but no cap plate to lie on".into(),
+            "a triple top plate needs the double top plate",
         ));
     }
-    if spec.detail.extra_cap_plates > 1 {
-        return Err(wall_err(
-            spec,
-            format!("{} plates on the cap plate", spec.detail.extra_cap_plates),
-            "a wall has at most a triple top plate",
-        ));
-    }
-    let plates =
-        if spec.double_top_plate { 3.0 } else { 2.0 } + spec.detail.extra_cap_plates as f64;
+    // Bottom and top plate, and the cap plates on the top plate.
+    let plates = match (spec.double_top_plate, spec.detail.triple_top_plate) {
+        (false, _) => 2.0,
+        (true, false) => 3.0,
+        (true, true) => 4.0,
+    };
     check_range(
         spec,
         "height",
@@ -226,13 +208,6 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
     let stud_top = spec.height - (plates - 1.0) * t;
     for &row in &spec.detail.blocking_rows {
         check_range(spec, "blocking row height", row, t, stud_top - t)?;
-    }
-    if !(1..=2).contains(&spec.detail.sill_plies) {
-        return Err(wall_err(
-            spec,
-            format!("{} sill plies", spec.detail.sill_plies),
-            "a rough sill is single or double (1 or 2 plies)",
-        ));
     }
     let openings = place_openings(spec, stud_top)?;
 
@@ -371,14 +346,13 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
                 [o.u0, o.u1]
             };
             // A double sill: the second ply under the first; the cripples stop under the lowest.
-            let plies = spec.detail.sill_plies as f64;
-            for k in 0..spec.detail.sill_plies {
+            let plies: &[&str] = if spec.detail.double_sill {
+                &["upper ply", "lower ply"]
+            } else {
+                &[""]
+            };
+            for (k, detail) in plies.iter().enumerate() {
                 let top = sill - k as f64 * t;
-                let detail = match (spec.detail.sill_plies, k) {
-                    (1, _) => "",
-                    (_, 0) => "upper ply",
-                    _ => "lower ply",
-                };
                 spanning.push(piece(
                     Role::Sill,
                     detail,
@@ -390,7 +364,7 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
                     },
                 ));
             }
-            let sill_bottom = sill - plies * t;
+            let sill_bottom = sill - plies.len() as f64 * t;
             if sill_top.is_some() {
                 // Under each jack, a cripple carries the sill's end.
                 for u0 in [o.u0 - t, o.u1] {
@@ -493,45 +467,25 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
 
     // Rows of flat blocking in the bays between uprights that cross the row, clear of every
     // sill, header and rough opening.
+    let uprights: Vec<WallBox> = standing.iter().chain(&above).map(|p| p.wall_box).collect();
+    let mut obstacles: Vec<WallBox> = spanning.iter().map(|p| p.wall_box).collect();
+    obstacles.extend(openings.iter().map(|o| WallBox {
+        u: [o.u0, o.u1],
+        v: [o.v0, o.v1],
+        w: full_w,
+    }));
     for &row in &spec.detail.blocking_rows {
         let band = [row, row + t];
-        let mut posts: Vec<[f64; 2]> = standing
-            .iter()
-            .chain(&above)
-            .map(|p| p.wall_box)
-            .filter(|b| b.v[0] <= band[0] + 1e-9 && b.v[1] >= band[1] - 1e-9)
-            .map(|b| b.u)
-            .collect();
-        posts.sort_by(|a, b| a[0].total_cmp(&b[0]));
-        let overlaps = |a: [f64; 2], b: [f64; 2]| a[0] < b[1] - 1e-9 && b[0] < a[1] - 1e-9;
-        let mut row_pieces = Vec::new();
-        for pair in posts.windows(2) {
-            let gap = [pair[0][1], pair[1][0]];
-            // A bay narrower than the lumber is wide takes no block (it would lie across the
-            // wall, not along it).
-            if gap[1] - gap[0] < depth {
-                continue;
-            }
-            let crosses_framing = spanning
-                .iter()
-                .any(|s| overlaps(s.wall_box.u, gap) && overlaps(s.wall_box.v, band))
-                || openings
-                    .iter()
-                    .any(|o| overlaps([o.u0, o.u1], gap) && overlaps([o.v0, o.v1], band));
-            if !crosses_framing {
-                row_pieces.push(piece(
-                    Role::Blocking,
-                    "",
-                    nominal,
-                    WallBox {
-                        u: gap,
-                        v: band,
-                        w: full_w,
-                    },
-                ));
-            }
+        // A row is an obstacle to the rows after it (rows closer than a block's thickness).
+        for bay in blocking_bays(band, &uprights, &obstacles, depth) {
+            let b = WallBox {
+                u: bay,
+                v: band,
+                w: full_w,
+            };
+            obstacles.push(b);
+            spanning.push(piece(Role::Blocking, "", nominal, b));
         }
-        spanning.extend(row_pieces);
     }
 
     let by_u = |a: &Piece, b: &Piece| {
@@ -557,7 +511,7 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         },
     ));
     if spec.double_top_plate {
-        for k in 0..=spec.detail.extra_cap_plates {
+        for k in 0..=u32::from(spec.detail.triple_top_plate) {
             let v0 = stud_top + (1 + k) as f64 * t;
             pieces.push(piece(
                 Role::CapPlate,
@@ -581,6 +535,34 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         pieces,
         openings: records,
     })
+}
+
+/// The bays (u ranges) of a row of blocking at heights `band`: between neighbouring uprights
+/// that both cross the row, at least `min_bay` wide (a shorter block would lie across the
+/// wall, not along it), and meeting no obstacle (a sill, header or rough opening) in the band.
+fn blocking_bays(
+    band: [f64; 2],
+    uprights: &[WallBox],
+    obstacles: &[WallBox],
+    min_bay: f64,
+) -> Vec<[f64; 2]> {
+    let overlaps = |a: [f64; 2], b: [f64; 2]| a[0] < b[1] - 1e-9 && b[0] < a[1] - 1e-9;
+    let mut posts: Vec<[f64; 2]> = uprights
+        .iter()
+        .filter(|b| b.v[0] <= band[0] + 1e-9 && b.v[1] >= band[1] - 1e-9)
+        .map(|b| b.u)
+        .collect();
+    posts.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    posts
+        .windows(2)
+        .map(|pair| [pair[0][1], pair[1][0]])
+        .filter(|bay| bay[1] - bay[0] >= min_bay)
+        .filter(|bay| {
+            !obstacles
+                .iter()
+                .any(|o| overlaps(o.u, *bay) && overlaps(o.v, band))
+        })
+        .collect()
 }
 
 /// Validate openings against the wall and each other; sorted by u.
@@ -623,7 +605,7 @@ fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, 
         let (v0, v1) = match o.kind {
             OpeningKind::Door => (0.0, o.height),
             OpeningKind::Window { sill } => {
-                let plies = spec.detail.sill_plies.max(1) as f64;
+                let plies = if spec.detail.double_sill { 2.0 } else { 1.0 };
                 if !sill.is_finite() || sill - plies * t < t + 0.05 {
                     return Err(err(
                         format!(
