@@ -562,3 +562,144 @@ fn grids_multiply_buildings_and_refuse_empty_or_huge_ones() {
     assert!(grid(&spec, 0, 3, 3.0, "g").is_err());
     assert!(grid(&spec, 1000, 1000, 3.0, "g").is_err());
 }
+
+/// Corners (a flat backer at the inner face, a three-stud post with spacer blocks, ladder
+/// blocking), partition backers, windows side by side sharing a king stud and a let-in
+/// brace: each where framing puts it, and no two pieces overlap but the brace, which crosses
+/// the studs and plates it is let into.
+#[test]
+fn corners_partitions_shared_kings_and_braces_fit_the_frame() {
+    use framewright::synth::wall::{CornerStyle, FramingDetail, PartitionSpec, PartitionStyle};
+    let t = Lumber::L2X4.thickness;
+    let depth = Lumber::L2X4.width;
+    let window = |u: f64| OpeningSpec {
+        kind: OpeningKind::Window { sill: inches(44.0) },
+        u,
+        width: inches(30.0),
+        height: inches(24.0),
+    };
+    for corners in [
+        CornerStyle::Backer,
+        CornerStyle::ThreeStud,
+        CornerStyle::Ladder,
+    ] {
+        // Jack, king, jack between the two rough openings: the king is shared.
+        let mut spec = twelve_foot_wall(
+            vec![window(inches(34.0)), window(inches(64.0) + 3.0 * t)],
+            HeaderStyle::BuiltUp,
+        );
+        spec.length = feet(20.0);
+        spec.detail = FramingDetail {
+            corners,
+            partitions: vec![
+                PartitionSpec {
+                    u: feet(12.0),
+                    style: PartitionStyle::Backer,
+                },
+                PartitionSpec {
+                    u: feet(16.0),
+                    style: PartitionStyle::Ladder,
+                },
+            ],
+            braces: vec![inches(106.0)],
+            ..FramingDetail::default()
+        };
+        let wall = frame_wall(
+            &spec,
+            framewright::synth::layout::WallFrame::upright(Vec3::zeros(), Vec3::x()),
+        )
+        .unwrap();
+        let len = spec.length;
+        let of = |role: Role| -> Vec<framewright::synth::layout::WallBox> {
+            wall.pieces
+                .iter()
+                .filter(|p| p.role == role)
+                .map(|p| p.wall_box)
+                .collect()
+        };
+        let near = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        let full_depth = |b: &framewright::synth::layout::WallBox| near(b.w[1] - b.w[0], depth);
+        let posts: Vec<_> = wall
+            .pieces
+            .iter()
+            .filter(|p| p.upright && full_depth(&p.wall_box))
+            .map(|p| p.wall_box)
+            .collect();
+        let touches_post = |u: f64| posts.iter().any(|b| near(b.u[0], u) || near(b.u[1], u));
+
+        // Three kings; the middle one has a jack against each face.
+        let kings = of(Role::KingStud);
+        assert_eq!(kings.len(), 3, "{corners:?}");
+        let middle = kings[1];
+        let jacks = of(Role::JackStud);
+        assert!(jacks.iter().any(|j| near(j.u[1], middle.u[0])));
+        assert!(jacks.iter().any(|j| near(j.u[0], middle.u[1])));
+
+        // Flat studs lie at the inner face with both ends, or one at a corner, on a post.
+        let flat: Vec<_> = of(Role::Stud)
+            .into_iter()
+            .filter(|b| !full_depth(b))
+            .collect();
+        for b in &flat {
+            assert!(near(b.w[0], depth - t) && near(b.w[1], depth), "{b:?}");
+            assert!(near(b.u[1] - b.u[0], depth), "{b:?}");
+            assert!(touches_post(b.u[0]) || touches_post(b.u[1]), "{b:?}");
+        }
+        let corner_backers = if corners == CornerStyle::Backer { 2 } else { 0 };
+        assert_eq!(flat.len(), 1 + corner_backers, "{corners:?}");
+
+        // Blocks lying (ladder) touch a post at both ends and neither plate.
+        let stud_top = spec.height - 2.0 * t;
+        let lying_blocks: Vec<_> = wall
+            .pieces
+            .iter()
+            .filter(|p| p.role == Role::Blocking && !p.upright)
+            .map(|p| p.wall_box)
+            .collect();
+        for b in &lying_blocks {
+            assert!(touches_post(b.u[0]) && touches_post(b.u[1]), "{b:?}");
+            assert!(b.v[0] > t + 1e-3 && b.v[1] < stud_top - 1e-3, "{b:?}");
+        }
+        // Spacer blocks stand between the end stud and the second stud of the corner post.
+        let spacers: Vec<_> = wall
+            .pieces
+            .iter()
+            .filter(|p| p.role == Role::Blocking && p.upright)
+            .map(|p| p.wall_box)
+            .collect();
+        if corners == CornerStyle::ThreeStud {
+            assert_eq!(spacers.len(), 6);
+            for b in &spacers {
+                let at_start = near(b.u[0], t) && near(b.u[1], 2.0 * t);
+                let at_end = near(b.u[1], len - t) && near(b.u[0], len - 2.0 * t);
+                assert!(at_start || at_end, "{b:?}");
+            }
+        } else {
+            assert!(spacers.is_empty());
+        }
+
+        // The brace: 45°, from the bottom plate's top to the top plate's underside, in the
+        // outer face, clear of every king stud's u range.
+        let brace = wall.pieces.iter().find(|p| p.role == Role::Brace).unwrap();
+        let (a, b) = (brace.start, brace.end);
+        assert!(near((b.x - a.x).abs(), (b.z - a.z).abs()), "{a:?} {b:?}");
+        assert!(near(a.z, t) && near(b.z, stud_top));
+        assert!(near(brace.wall_box.w[0], 0.0) && near(brace.wall_box.w[1], 0.75 * 0.0254));
+        let overlap = |x: [f64; 2], y: [f64; 2]| x[0] < y[1] - 1e-9 && y[0] < x[1] - 1e-9;
+        assert!(kings.iter().all(|k| !overlap(k.u, brace.wall_box.u)));
+
+        for (i, p) in wall.pieces.iter().enumerate() {
+            for q in &wall.pieces[i + 1..] {
+                let (x, y) = (p.wall_box, q.wall_box);
+                let crossing = overlap(x.u, y.u) && overlap(x.v, y.v) && overlap(x.w, y.w);
+                let brace = p.role == Role::Brace || q.role == Role::Brace;
+                assert!(
+                    !crossing || brace,
+                    "{corners:?}: {:?} {x:?} overlaps {:?} {y:?}",
+                    p.role,
+                    q.role
+                );
+            }
+        }
+    }
+}

@@ -7,7 +7,8 @@ use framewright::synth::layout::{Layout, Vec3};
 use framewright::synth::models;
 use framewright::synth::units::{Lumber, parse_length};
 use framewright::synth::wall::{
-    FramingDetail, HeaderStyle, OpeningKind, OpeningSpec, SillStyle, StudLayout, WallSpec,
+    CornerStyle, FramingDetail, HeaderStyle, OpeningKind, OpeningSpec, PartitionSpec,
+    PartitionStyle, SillStyle, StudLayout, WallSpec,
 };
 use framewright::synth::{
     Grouping, LengthUnit, PlacementBase, ProductClasses, Schema, SynthError, WriteOptions,
@@ -40,6 +41,18 @@ pub enum HeaderArg {
     Solid,
     /// One flat piece of the wall's lumber between the king studs, no jack studs.
     Flat,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum CornerArg {
+    /// One end stud.
+    Single,
+    /// The end stud and a stud turned flat beside it at the inner face (California corner).
+    Backer,
+    /// The end stud and a second stud with spacer blocks between (three-stud corner).
+    ThreeStud,
+    /// The end stud and a second stud one bay in, ladder blocks between.
+    Ladder,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -153,6 +166,18 @@ pub struct GeometryArgs {
     /// the floor (fire or mid-height blocking); repeatable.
     #[arg(long, value_name = "HEIGHT")]
     pub blocking: Vec<String>,
+    /// For `wall`: a let-in 1x4 brace in the outer face rising at 45° from the bottom plate
+    /// at this u towards the wall end; repeatable.
+    #[arg(long, value_name = "U")]
+    pub brace: Vec<String>,
+    /// For `wall`: how both wall ends are framed.
+    #[arg(long, value_enum, default_value = "single")]
+    pub corner: CornerArg,
+    /// For `wall`: a partition wall meeting this one, centred U from the wall start, backed
+    /// by a flat stud between two studs (`U` or `U:backer`) or by ladder blocking
+    /// (`U:ladder`); repeatable.
+    #[arg(long, value_name = "U[:STYLE]")]
+    pub partition: Vec<String>,
     /// For `building`: leave out the default door and windows.
     #[arg(long)]
     pub no_openings: bool,
@@ -324,6 +349,26 @@ fn opening(text: &str, window: bool) -> Result<OpeningSpec, SynthError> {
     })
 }
 
+/// Read `U` or `U:backer` / `U:ladder`.
+fn partition(text: &str) -> Result<PartitionSpec, SynthError> {
+    let (u, style) = text.split_once(':').unwrap_or((text, "backer"));
+    let style = match style {
+        "backer" => PartitionStyle::Backer,
+        "ladder" => PartitionStyle::Ladder,
+        _ => {
+            return Err(SynthError::Parse {
+                what: "partition",
+                value: text.into(),
+                hint: "write U, U:backer or U:ladder, e.g. 8ft:ladder".into(),
+            });
+        }
+    };
+    Ok(PartitionSpec {
+        u: parse_length(u)?,
+        style,
+    })
+}
+
 fn wall_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
     let mut openings = Vec::new();
     for d in &args.geometry.door {
@@ -360,6 +405,24 @@ fn wall_layout(args: &SynthArgs) -> Result<Layout, SynthError> {
                 .blocking
                 .iter()
                 .map(|h| parse_length(h.as_str()))
+                .collect::<Result<_, _>>()?,
+            braces: args
+                .geometry
+                .brace
+                .iter()
+                .map(|u| parse_length(u.as_str()))
+                .collect::<Result<_, _>>()?,
+            corners: match args.geometry.corner {
+                CornerArg::Single => CornerStyle::Single,
+                CornerArg::Backer => CornerStyle::Backer,
+                CornerArg::ThreeStud => CornerStyle::ThreeStud,
+                CornerArg::Ladder => CornerStyle::Ladder,
+            },
+            partitions: args
+                .geometry
+                .partition
+                .iter()
+                .map(|p| partition(p))
                 .collect::<Result<_, _>>()?,
         },
     };

@@ -28,7 +28,8 @@ pub fn restrict_to_containers(facts: &Facts, containers: &BTreeSet<String>) -> F
     let mut out = Facts::default();
     for (name, tuples) in &facts.tuples {
         for (t, origin) in tuples {
-            let keep = inside(t.first()) && (*name != "contact" || inside(t.get(1)));
+            let keep = inside(t.first())
+                && (!super::facts::PAIR_RELATIONS.contains(name) || inside(t.get(1)));
             if keep {
                 out.add(name, t.clone(), origin.clone());
             }

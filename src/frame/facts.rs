@@ -1,7 +1,7 @@
 //! IFC model → input facts of the rule base (`rules/facts.dl`). Every tuple
 //! keeps its origin: the IFC entity it was read from.
 
-use crate::geom::{ContactOptions, OrientedBox, contacts};
+use crate::geom::{ContactOptions, OrientedBox, contacts_and_crossings};
 use crate::ifc::Model;
 use crate::logic::compiled::Relations;
 use crate::logic::value::Sym;
@@ -13,6 +13,10 @@ use std::sync::Arc;
 /// Density used when the model names no material we know, kg/m³
 /// (spruce-pine-fir, the study's lumber, at about 12 % moisture).
 pub const DEFAULT_DENSITY: f64 = 450.0;
+
+/// Relations about two pieces (the first two arguments): a tuple belongs to a part of the
+/// model only when both of its pieces do.
+pub const PAIR_RELATIONS: [&str; 2] = ["contact", "crossing"];
 
 /// Densities of common framing species, kg/m³ (typical values at about 12 %
 /// moisture); matched case-insensitively against the material name.
@@ -129,7 +133,7 @@ fn split_by_container(tuples: BTreeMap<&'static str, Vec<Vec<Value>>>) -> Vec<Re
         let mut buckets: Vec<Vec<Vec<Value>>> = vec![Vec::new(); n];
         for tuple in relation {
             match part_of(tuple.first()) {
-                Some(k) if name == "contact" => {
+                Some(k) if PAIR_RELATIONS.contains(&name) => {
                     if part_of(tuple.get(1)) == Some(k) {
                         buckets[k].push(tuple);
                     }
@@ -190,7 +194,7 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
         })
         .collect();
     let boxes: Vec<OrientedBox> = pieces.iter().map(|p| p.obox).collect();
-    let found = contacts(&boxes, contact_options);
+    let (found, crossings) = contacts_and_crossings(&boxes, contact_options);
     let contact_runs: Vec<Facts> = found
         .par_chunks(PER_RUN)
         .map(|run| {
@@ -201,8 +205,28 @@ pub fn model_facts(model: &Model, contact_options: &ContactOptions) -> Facts {
             facts
         })
         .collect();
+    // Only crossings of an inclined piece (a let-in brace) are facts: the rules read no others,
+    // and a stray overlap elsewhere would otherwise add a relation to every part of the model.
+    let inclined = |k: usize| {
+        let z = boxes[k].axes[0].z.abs();
+        z > 0.1 - 1e-6 && z < 0.9 + 1e-6
+    };
+    let mut crossing_facts = Facts::default();
+    for c in crossings.iter().filter(|c| inclined(c.a) || inclined(c.b)) {
+        for (a, b) in [(c.a, c.b), (c.b, c.a)] {
+            crossing_facts.add(
+                "crossing",
+                vec![ids[a].clone(), ids[b].clone(), Value::float(c.depth)],
+                Origin::Entity(pieces[a].entity),
+            );
+        }
+    }
     let mut facts = Facts::default();
-    for run in piece_runs.into_iter().chain(contact_runs) {
+    for run in piece_runs
+        .into_iter()
+        .chain(contact_runs)
+        .chain([crossing_facts])
+    {
         for (relation, tuples) in run.tuples {
             facts.tuples.entry(relation).or_default().extend(tuples);
         }

@@ -1,6 +1,8 @@
 //! Splits a model's facts into parts finer than its containers: the pieces of one container
-//! joined by a contact that can make them coplanar (one wall) or by an IFC group. The built-in
-//! rules relate two pieces of different walls only through such a contact (walls are
+//! joined by a contact that can make them coplanar (one wall), a contact of a piece the rules
+//! may attach to a wall (turned flat, or touching nothing coplanar) lying within the other's
+//! thickness, a crossing of an inclined piece (a let-in brace), or an IFC group. The
+//! built-in rules relate two pieces of different walls only through such a contact (walls are
 //! connected coplanar contacts; roles, order and nailing read contacts within one wall) or a
 //! shared group (`group_split`), so a part's walls, roles, order and targets come from its own
 //! facts, with one exception: `storey_reach`, how far the whole container's lumber reaches
@@ -107,15 +109,62 @@ impl Partition {
                 .and_then(|p| piece_index.get(&p).copied())
         };
         let mut across: Vec<Vec<Vector3<f64>>> = vec![Vec::new(); pieces.len()];
+        let mut boxes: Vec<Option<&OBox>> = vec![None; pieces.len()];
         for (t, _) in facts.tuples.get("piece_box").into_iter().flatten() {
             if let (Some(p), Some(Value::Box(b))) = (find(t.first()), t.get(1)) {
                 across[p] = across_candidates(b);
+                boxes[p] = Some(b);
             }
         }
-        for (t, _) in facts.tuples.get("contact").into_iter().flatten() {
+        let inside = |a: usize, b: usize| match (boxes[a], boxes[b]) {
+            (Some(ba), Some(bb)) => within_thickness(ba, bb, &across[b]),
+            _ => false,
+        };
+        // (a, b, whether a meets b with its end along a plumb normal), as `turned_flat` reads.
+        let contacts: Vec<(usize, usize, bool)> = facts
+            .tuples
+            .get("contact")
+            .into_iter()
+            .flatten()
+            .filter_map(|(t, _)| {
+                let end_on = t.get(3).and_then(Value::as_symbol) == Some("end")
+                    && t.get(6)
+                        .and_then(Value::as_vec3)
+                        .is_some_and(|n| n.z.abs() > 0.9 - MARGIN);
+                Some((find(t.first())?, find(t.get(1))?, end_on))
+            })
+            .filter(|&(a, b, _)| container_of[a] == container_of[b])
+            .collect();
+        // Pieces the rules may attach to a wall they lie in (rule `may_attach`): turned flat,
+        // or with no contact that can make them coplanar with anything.
+        let mut coplanar_capable = vec![false; pieces.len()];
+        let mut turned = vec![false; pieces.len()];
+        for &(a, b, end_on) in &contacts {
+            if may_be_coplanar(&across[a], &across[b]) {
+                coplanar_capable[a] = true;
+            }
+            if let (Some(ba), Some(bb)) = (boxes[a], boxes[b])
+                && end_on
+                && may_be_turned_flat(ba, &across[a], bb, &across[b])
+            {
+                turned[a] = true;
+            }
+        }
+        let loose = |p: usize| turned[p] || !coplanar_capable[p];
+        for &(a, b, _) in &contacts {
+            if may_be_coplanar(&across[a], &across[b])
+                || (loose(a) && inside(a, b))
+                || (loose(b) && inside(b, a))
+            {
+                sets.join(a, b);
+            }
+        }
+        // A piece crossing another (a let-in brace through the studs) joins its wall when it
+        // is inclined (rule `attached_crossing`).
+        for (t, _) in facts.tuples.get("crossing").into_iter().flatten() {
             if let (Some(a), Some(b)) = (find(t.first()), find(t.get(1)))
                 && container_of[a] == container_of[b]
-                && may_be_coplanar(&across[a], &across[b])
+                && (boxes[a].is_some_and(may_be_inclined) || boxes[b].is_some_and(may_be_inclined))
             {
                 sets.join(a, b);
             }
@@ -169,7 +218,7 @@ impl Partition {
                 for (j, (tuple, _)) in tuples.iter().enumerate() {
                     let j = j as u32;
                     match find(tuple.first()).map(|p| part_of[p]) {
-                        Some(k) if *name == "contact" => {
+                        Some(k) if super::facts::PAIR_RELATIONS.contains(name) => {
                             if find(tuple.get(1)).map(|p| part_of[p]) == Some(k) {
                                 buckets[k].push(j);
                             }
@@ -329,6 +378,41 @@ fn may_be_coplanar(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> bool {
         .any(|da| b.iter().any(|db| da.dot(db).abs() > 0.99 - MARGIN))
 }
 
+/// Whether the rule `attached_inside_thickness` can hold for box `a` touching box `b`: `a`
+/// lies within `b`'s extent along one of `b`'s across candidates (a piece turned flat inside
+/// a wall joins the wall of a piece it touches).
+fn within_thickness(a: &OBox, b: &OBox, b_across: &[Vector3<f64>]) -> bool {
+    let radius = |bx: &OBox, d: &Vector3<f64>| -> f64 {
+        (0..3).map(|k| bx.half[k] * bx.axis(k).dot(d).abs()).sum()
+    };
+    b_across.iter().any(|d| {
+        (a.centre() - b.centre()).dot(d).abs() + radius(a, d) <= radius(b, d) + 0.003 + MARGIN
+    })
+}
+
+/// Whether the rule `turned_flat` can hold for upright `a` touching `b`: `b` lies level,
+/// their across directions are (nearly) square, and `a` lies within `b`'s thickness.
+fn may_be_turned_flat(
+    a: &OBox,
+    a_across: &[Vector3<f64>],
+    b: &OBox,
+    b_across: &[Vector3<f64>],
+) -> bool {
+    a.axis(0).z.abs() > 0.9 - MARGIN
+        && b.axis(0).z.abs() < 0.1 + MARGIN
+        && a_across
+            .iter()
+            .any(|da| b_across.iter().any(|db| da.dot(db).abs() < 0.1 + MARGIN))
+        && within_thickness(a, b, b_across)
+}
+
+/// Whether the rule `inclined` (rules/walls.dl) can hold for a piece with this box: its
+/// length neither plumb nor level.
+fn may_be_inclined(b: &OBox) -> bool {
+    let z = b.axis(0).z.abs();
+    z > 0.1 - MARGIN && z < 0.9 + MARGIN
+}
+
 /// `piece_index` tuples renumbered 0.. in the order of their indices (ties in the order
 /// given).
 fn renumber<T: AsRef<[Value]> + From<Vec<Value>>>(tuples: &mut [T]) {
@@ -391,12 +475,16 @@ mod tests {
         f
     }
 
-    /// An upright's box: length plumb, width along `width` (horizontal).
+    /// An upright's box at the origin: length plumb, width along `width` (horizontal).
     fn upright(width: Vector3<f64>) -> Value {
+        upright_at(width, Vector3::zeros())
+    }
+
+    fn upright_at(width: Vector3<f64>, centre: Vector3<f64>) -> Value {
         let x = Vector3::z();
         let m = nalgebra::Matrix3::from_columns(&[x, width, x.cross(&width)]);
         let pose = nalgebra::Isometry3::from_parts(
-            nalgebra::Translation3::identity(),
+            nalgebra::Translation3::from(centre),
             nalgebra::UnitQuaternion::from_matrix(&m),
         );
         Value::Box(std::sync::Arc::new(OBox {
@@ -424,7 +512,24 @@ mod tests {
             ("piece_box", vec![s("a"), upright(Vector3::x())]),
             ("piece_box", vec![s("b"), upright(-Vector3::x())]),
             ("piece_box", vec![s("e"), upright(Vector3::x())]),
-            ("piece_box", vec![s("f"), upright(Vector3::y())]),
+            // f stands beside a, outside a's width (the end of a crossing wall); g, turned
+            // flat, stands within a's width (a flat stud in a's wall).
+            (
+                "piece_box",
+                vec![
+                    s("f"),
+                    upright_at(Vector3::y(), Vector3::new(0.064, 0.0, 0.0)),
+                ],
+            ),
+            ("piece_container", vec![s("g"), s("S1")]),
+            (
+                "piece_box",
+                vec![
+                    s("g"),
+                    upright_at(Vector3::y(), Vector3::new(0.026, 0.0, 0.0)),
+                ],
+            ),
+            contact("a", "g"),
             ("piece_index", vec![s("a"), Value::Number(4)]),
             ("piece_index", vec![s("c"), Value::Number(9)]),
             ("piece_index", vec![s("d"), Value::Number(7)]),
@@ -439,13 +544,13 @@ mod tests {
         let pieces: Vec<Vec<String>> = p.parts.iter().map(|q| q.pieces.clone()).collect();
         assert_eq!(
             pieces,
-            vec![vec!["a", "b"], vec!["c", "d"], vec!["e"], vec!["f"]]
+            vec![vec!["a", "b", "g"], vec!["c", "d"], vec!["e"], vec!["f"]]
         );
         assert_eq!(p.parts[1].groups, vec!["G"]);
         // The contact across containers and the one across walls (a crossing upright) go
         // nowhere; the cell goes everywhere.
         let of = |k: usize| p.relations(&f, &[k], Indices::Renumbered);
-        assert_eq!(of(0)["contact"].len(), 1);
+        assert_eq!(of(0)["contact"].len(), 2);
         assert!(of(2)["contact"].is_empty());
         assert!(of(3)["contact"].is_empty());
         assert!((0..p.parts.len()).all(|k| of(k)["cell_value"].len() == 1));

@@ -87,15 +87,47 @@ impl Default for ContactOptions {
     }
 }
 
+/// Two pieces passing through each other deeper than the contact tolerance (a let-in brace
+/// crosses studs modelled without their notches). Indices as in [`Contact`]; `a < b`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Crossing {
+    pub a: usize,
+    pub b: usize,
+    /// How deep they overlap along the direction that separates them least, metres.
+    pub depth: f64,
+}
+
 /// All touching pairs, sorted by `(a, b)`.
 pub fn contacts(boxes: &[OrientedBox], options: &ContactOptions) -> Vec<Contact> {
+    contacts_and_crossings(boxes, options).0
+}
+
+/// All touching pairs and all crossing pairs, each sorted by `(a, b)`.
+pub fn contacts_and_crossings(
+    boxes: &[OrientedBox],
+    options: &ContactOptions,
+) -> (Vec<Contact>, Vec<Crossing>) {
     use rayon::prelude::*;
-    let mut found: Vec<Contact> = candidate_pairs(boxes, options.tolerance)
+    let found: Vec<Meeting> = candidate_pairs(boxes, options.tolerance)
         .into_par_iter()
         .filter_map(|(a, b)| touch(boxes, a, b, options))
         .collect();
-    found.sort_by_key(|c| (c.a, c.b));
-    found
+    let (mut touching, mut crossing) = (Vec::new(), Vec::new());
+    for m in found {
+        match m {
+            Meeting::Touch(c) => touching.push(c),
+            Meeting::Cross(c) => crossing.push(c),
+        }
+    }
+    touching.sort_by_key(|c| (c.a, c.b));
+    crossing.sort_by_key(|c| (c.a, c.b));
+    (touching, crossing)
+}
+
+/// How two boxes meet.
+enum Meeting {
+    Touch(Contact),
+    Cross(Crossing),
 }
 
 fn aabb(b: &OrientedBox, pad: f64) -> (Point3, Point3) {
@@ -170,8 +202,9 @@ fn radius(b: &OrientedBox, dir: &Vector3) -> f64 {
 }
 
 /// The separating-axis test restricted to the six face normals (the pieces of
-/// a frame are boxes whose faces meet); returns the contact if they touch.
-fn touch(boxes: &[OrientedBox], a: usize, b: usize, options: &ContactOptions) -> Option<Contact> {
+/// a frame are boxes whose faces meet, or that share the axis across their wall);
+/// returns the contact if they touch, the crossing if they pass through each other.
+fn touch(boxes: &[OrientedBox], a: usize, b: usize, options: &ContactOptions) -> Option<Meeting> {
     let (ba, bb) = (&boxes[a], &boxes[b]);
     let d = bb.centre - ba.centre;
     let mut best: Option<(f64, Vector3)> = None;
@@ -182,7 +215,10 @@ fn touch(boxes: &[OrientedBox], a: usize, b: usize, options: &ContactOptions) ->
         }
     }
     let (gap, axis) = best?;
-    if gap > options.tolerance || gap < -options.tolerance {
+    if gap < -options.tolerance {
+        return Some(Meeting::Cross(Crossing { a, b, depth: -gap }));
+    }
+    if gap > options.tolerance {
         return None;
     }
     let normal = if d.dot(&axis) >= 0.0 { axis } else { -axis };
@@ -229,7 +265,7 @@ fn touch(boxes: &[OrientedBox], a: usize, b: usize, options: &ContactOptions) ->
         (false, false) => ContactKind::FaceToFace,
         _ => ContactKind::EndToFace,
     };
-    Some(Contact {
+    Some(Meeting::Touch(Contact {
         a,
         b,
         kind,
@@ -239,7 +275,7 @@ fn touch(boxes: &[OrientedBox], a: usize, b: usize, options: &ContactOptions) ->
         normal,
         centre,
         size,
-    })
+    }))
 }
 
 #[cfg(test)]
@@ -293,6 +329,31 @@ mod tests {
     }
 
     #[test]
+    fn a_brace_through_a_stud_is_a_crossing_not_a_contact() {
+        // A 1x4 at 45° in the outer 19 mm of a 2x4 stud's depth.
+        let stud = piece([0.5, 0.0, 0.0], [0.5381, 0.0889, 2.4]);
+        let (c, s) = (
+            std::f64::consts::FRAC_1_SQRT_2,
+            std::f64::consts::FRAC_1_SQRT_2,
+        );
+        let brace = OrientedBox::new(
+            Point3::new(0.5, 0.0095, 1.0),
+            [
+                Vector3::new(c, 0.0, s),
+                Vector3::new(-s, 0.0, c),
+                Vector3::y(),
+            ],
+            [0.5, 0.0445, 0.0095],
+        );
+        let (touching, crossing) =
+            contacts_and_crossings(&[stud, brace], &ContactOptions::default());
+        assert!(touching.is_empty(), "{touching:?}");
+        assert_eq!(crossing.len(), 1);
+        // It overlaps the stud by its own thickness across the wall.
+        assert!((crossing[0].depth - 0.019).abs() < 1e-9, "{crossing:?}");
+    }
+
+    #[test]
     fn double_top_plate_is_face_to_face() {
         let top = piece([0.0, 0.0, 2.0], [3.0, 0.0889, 2.0381]);
         let cap = piece([0.0, 0.0, 2.0381], [3.0, 0.0889, 2.0762]);
@@ -315,7 +376,12 @@ mod tests {
         let found = contacts(&boxes, &ContactOptions::default());
         let brute: Vec<(usize, usize)> = (0..boxes.len())
             .flat_map(|a| (a + 1..boxes.len()).map(move |b| (a, b)))
-            .filter(|&(a, b)| touch(&boxes, a, b, &ContactOptions::default()).is_some())
+            .filter(|&(a, b)| {
+                matches!(
+                    touch(&boxes, a, b, &ContactOptions::default()),
+                    Some(Meeting::Touch(_))
+                )
+            })
             .collect();
         assert_eq!(found.iter().map(|c| (c.a, c.b)).collect::<Vec<_>>(), brute);
         assert_eq!(found.len(), 80);

@@ -4,7 +4,9 @@
 mod contact;
 mod obox;
 
-pub use contact::{Contact, ContactKind, ContactOptions, Face, contacts};
+pub use contact::{
+    Contact, ContactKind, ContactOptions, Crossing, Face, contacts, contacts_and_crossings,
+};
 pub use obox::{OrientedBox, fit_points};
 
 pub type Point3 = nalgebra::Point3<f64>;

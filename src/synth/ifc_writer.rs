@@ -644,7 +644,7 @@ struct PlaceNames<'a> {
 fn write_property_set(ctx: &mut Ctx, wall: &WallLayout, k: usize, product: Ref) {
     let pset_name = match ctx.opts.products {
         ProductClasses::Member => "Pset_MemberCommon",
-        ProductClasses::ColumnBeam if wall.pieces.get(k).is_some_and(|p| p.role.is_vertical()) => {
+        ProductClasses::ColumnBeam if wall.pieces.get(k).is_some_and(|p| p.upright) => {
             "Pset_ColumnCommon"
         }
         ProductClasses::ColumnBeam => "Pset_BeamCommon",
@@ -835,7 +835,7 @@ fn write_piece_products(
     let wall = place.wall;
     let mut out = Vec::with_capacity(wall.pieces.len());
     for (k, piece) in wall.pieces.iter().enumerate() {
-        let vertical = piece.role.is_vertical();
+        let vertical = piece.upright;
         let kind = product_kind(
             ctx.opts.products,
             vertical,
@@ -933,7 +933,7 @@ fn write_mapped_wall(
     let mut rows: Vec<Option<TruthMember>> = vec![None; wall.pieces.len()];
     for (group, vertical) in [("studs", true), ("plates", false)] {
         let indices: Vec<usize> = (0..wall.pieces.len())
-            .filter(|&k| wall.pieces[k].role.is_vertical() == vertical)
+            .filter(|&k| wall.pieces[k].upright == vertical)
             .collect();
         if indices.is_empty() {
             continue;
@@ -1036,8 +1036,10 @@ fn truth_member(
         role: piece.role.as_str(),
         role_detail: piece.role_detail.clone(),
         nominal: piece.nominal.clone(),
-        orientation: if piece.role.is_vertical() {
+        orientation: if piece.upright {
             "vertical"
+        } else if piece.role == crate::synth::Role::Brace {
+            "inclined"
         } else {
             "horizontal"
         },

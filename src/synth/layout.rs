@@ -16,6 +16,7 @@ pub enum Role {
     Sill,
     CrippleStud,
     Blocking,
+    Brace,
 }
 
 impl Role {
@@ -31,6 +32,7 @@ impl Role {
             Role::Sill => "sill",
             Role::CrippleStud => "cripple_stud",
             Role::Blocking => "blocking",
+            Role::Brace => "brace",
         }
     }
 
@@ -109,11 +111,13 @@ pub struct Piece {
     pub width_dir: Vec3,
     /// Smaller cross-section dimension.
     pub thickness: f64,
+    /// Whether it stands (runs along v); it lies along u otherwise.
+    pub upright: bool,
 }
 
 impl Piece {
-    /// Build a piece from its box in the wall frame; it runs along v when `vertical`,
-    /// else along u. The wider of the two other box extents is the width.
+    /// Build a piece from its box in the wall frame; it runs along v when its role is
+    /// vertical, else along u. The wider of the two other box extents is the width.
     pub fn from_box(
         frame: &WallFrame,
         role: Role,
@@ -121,11 +125,33 @@ impl Piece {
         nominal: &str,
         b: WallBox,
     ) -> Piece {
+        Piece::oriented(frame, role, detail, nominal, b, role.is_vertical())
+    }
+
+    /// A piece standing along v whatever its role (the spacer blocks of a built-up post).
+    pub fn standing(
+        frame: &WallFrame,
+        role: Role,
+        detail: &str,
+        nominal: &str,
+        b: WallBox,
+    ) -> Piece {
+        Piece::oriented(frame, role, detail, nominal, b, true)
+    }
+
+    fn oriented(
+        frame: &WallFrame,
+        role: Role,
+        detail: &str,
+        nominal: &str,
+        b: WallBox,
+        upright: bool,
+    ) -> Piece {
         let mid = |r: [f64; 2]| 0.5 * (r[0] + r[1]);
         // Extents come from differences of positions; drop the float dust so equal
         // sections compare equal.
         let ext = |r: [f64; 2]| ((r[1] - r[0]) * 1e10).round() / 1e10;
-        let (start, end, cross) = if role.is_vertical() {
+        let (start, end, cross) = if upright {
             (
                 frame.to_world(mid(b.u), b.v[0], mid(b.w)),
                 frame.to_world(mid(b.u), b.v[1], mid(b.w)),
@@ -154,6 +180,44 @@ impl Piece {
             width: wide.0,
             width_dir: wide.1,
             thickness: narrow.0,
+            upright,
+        }
+    }
+
+    /// A piece running in the wall's plane from `(u, v)` at `from` to `to` (a brace), its
+    /// width in the plane and its thickness across the wall at `w`. Its `wall_box` is the box
+    /// around it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn inclined(
+        frame: &WallFrame,
+        role: Role,
+        detail: &str,
+        nominal: &str,
+        from: [f64; 2],
+        to: [f64; 2],
+        width: f64,
+        w: [f64; 2],
+    ) -> Piece {
+        let (du, dv) = (to[0] - from[0], to[1] - from[1]);
+        let len = du.hypot(dv);
+        // Half the width, across the axis in the plane: (-dv, du) / len.
+        let (hu, hv) = (0.5 * width * dv.abs() / len, 0.5 * width * du.abs() / len);
+        let mid_w = 0.5 * (w[0] + w[1]);
+        Piece {
+            role,
+            role_detail: detail.to_string(),
+            nominal: nominal.to_string(),
+            wall_box: WallBox {
+                u: [from[0].min(to[0]) - hu, from[0].max(to[0]) + hu],
+                v: [from[1].min(to[1]) - hv, from[1].max(to[1]) + hv],
+                w,
+            },
+            start: frame.to_world(from[0], from[1], mid_w),
+            end: frame.to_world(to[0], to[1], mid_w),
+            width,
+            width_dir: (frame.u * (-dv) + frame.v * du) / len,
+            thickness: w[1] - w[0],
+            upright: false,
         }
     }
 

@@ -52,8 +52,12 @@ pub struct Nail {
 pub fn precedence(wall: &WallLayout) -> Vec<Precedence> {
     let p = &wall.pieces;
     let mut out = Vec::new();
-    for (a, upper) in p.iter().enumerate() {
-        for (b, lower) in p.iter().enumerate() {
+    // A let-in brace crosses the pieces it is let into; it goes in last and rests on none.
+    let framing = |k: &usize| p[*k].role != Role::Brace;
+    for a in (0..p.len()).filter(framing) {
+        let upper = &p[a];
+        for b in (0..p.len()).filter(framing) {
+            let lower = &p[b];
             let (ub, lb) = (upper.wall_box, lower.wall_box);
             let rests = (ub.v[0] - lb.v[1]).abs() < TOUCH
                 && overlap(ub.u, lb.u) > TOUCH
@@ -66,8 +70,8 @@ pub fn precedence(wall: &WallLayout) -> Vec<Precedence> {
                 });
                 continue;
             }
-            let end_touch = !upper.role.is_vertical()
-                && lower.role.is_vertical()
+            let end_touch = !upper.upright
+                && lower.upright
                 && ((ub.u[0] - lb.u[1]).abs() < TOUCH || (ub.u[1] - lb.u[0]).abs() < TOUCH)
                 && overlap(ub.v, lb.v) > TOUCH
                 && overlap(ub.w, lb.w) > TOUCH;
@@ -107,15 +111,19 @@ pub fn nailing_targets(wall: &WallLayout) -> (Vec<Nail>, Vec<Nail>) {
         for (j, m) in p.iter().enumerate() {
             let mb = m.wall_box;
             let end = if dir > 0.0 { mb.v[0] } else { mb.v[1] };
-            if !m.role.is_vertical()
+            // Spacer blocks are nailed through the studs they fill between, not the plates.
+            if !m.upright
+                || m.role == Role::Blocking
                 || (end - member_end_at).abs() > TOUCH
                 || overlap(mb.u, pb.u) <= TOUCH
             {
                 continue;
             }
             let u = 0.5 * (mb.u[0] + mb.u[1]);
+            // Across the width the plate and the member share (a flat stud is thin in w).
+            let (w0, w1) = (pb.w[0].max(mb.w[0]), pb.w[1].min(mb.w[1]));
             for k in [1.0, 2.0] {
-                let w = pb.w[0] + k / 3.0 * (pb.w[1] - pb.w[0]);
+                let w = w0 + k / 3.0 * (w1 - w0);
                 out.push(Nail {
                     plate: i,
                     member: j,

@@ -37,6 +37,39 @@ pub enum SillStyle {
     KingToKing,
 }
 
+/// How both ends of a wall are framed, where another wall meets it at a corner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CornerStyle {
+    /// One end stud.
+    #[default]
+    Single,
+    /// The end stud and a stud turned flat beside it at the inner face, to nail the other
+    /// wall's board to (a California corner).
+    Backer,
+    /// The end stud and a second stud with three spacer blocks between them (a three-stud
+    /// corner post).
+    ThreeStud,
+    /// The end stud and a second stud one bay in, with flat blocks between them every
+    /// 24 in up the wall (ladder blocking).
+    Ladder,
+}
+
+/// How the place where a partition wall meets this one mid-length is backed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PartitionStyle {
+    /// Two studs with a stud turned flat between them at the inner face.
+    Backer,
+    /// Two studs one bay apart with flat blocks between them every 24 in (ladder blocking).
+    Ladder,
+}
+
+/// A partition wall meeting this wall's inner face, centred `u` from the wall start.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PartitionSpec {
+    pub u: f64,
+    pub style: PartitionStyle,
+}
+
 /// Framing details beyond the studs on centre and the openings.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct FramingDetail {
@@ -51,6 +84,13 @@ pub struct FramingDetail {
     /// each row's underside above the floor (m). A row skips the bays an opening's framing
     /// crosses.
     pub blocking_rows: Vec<f64>,
+    /// Let-in 1x4 braces in the outer face, each rising at 45° from the bottom plate at
+    /// this u (m from the wall start) towards the wall end, up to the top plate.
+    pub braces: Vec<f64>,
+    /// How both wall ends are framed.
+    pub corners: CornerStyle,
+    /// Partition walls meeting this one.
+    pub partitions: Vec<PartitionSpec>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,6 +147,15 @@ const MAX_SPACING: f64 = 48.0 * INCH;
 const SPACER: f64 = 0.5 * INCH;
 /// Gaps above a header smaller than this get no cripple (too short to nail).
 const MIN_CRIPPLE: f64 = 1.0 * INCH;
+/// Clear bay of ladder blocking (studs 16 in on centre, less one stud).
+const LADDER_BAY: f64 = 14.5 * INCH;
+/// Ladder blocks every 24 in up the wall.
+const LADDER_STEP: f64 = 24.0 * INCH;
+/// A let-in brace's 1x4 section.
+const BRACE_WIDTH: f64 = 3.5 * INCH;
+const BRACE_THICKNESS: f64 = 0.75 * INCH;
+/// Length of a three-stud corner's spacer blocks.
+const SPACER_BLOCK: f64 = 12.0 * INCH;
 
 /// Header lumber by clear span: deep enough for light residential loads.
 fn header_lumber(span: f64) -> Option<Lumber> {
@@ -165,6 +214,52 @@ impl PlacedOpening {
     fn zone(&self, t: f64) -> [f64; 2] {
         [self.u0 - self.beside * t, self.u1 + self.beside * t]
     }
+
+    /// Where the left and right king studs start (u): beyond the jacks, or at the opening's
+    /// edges when a flat header has none.
+    fn kings(&self, t: f64, jacks: bool) -> [f64; 2] {
+        if jacks {
+            [self.u0 - 2.0 * t, self.u1 + t]
+        } else {
+            [self.u0 - t, self.u1]
+        }
+    }
+}
+
+/// How far a corner's framing reaches in from the wall end, end stud included.
+fn corner_extent(style: CornerStyle, t: f64, depth: f64) -> f64 {
+    match style {
+        CornerStyle::Single => t,
+        CornerStyle::Backer => t + depth,
+        CornerStyle::ThreeStud => 3.0 * t,
+        CornerStyle::Ladder => 2.0 * t + LADDER_BAY,
+    }
+}
+
+/// The clear space between a partition's two studs.
+fn partition_clear(style: PartitionStyle, depth: f64) -> f64 {
+    match style {
+        PartitionStyle::Backer => depth,
+        PartitionStyle::Ladder => LADDER_BAY,
+    }
+}
+
+/// The u range of a partition's framing, outer face to outer face of its studs.
+fn partition_zone(p: &PartitionSpec, t: f64, depth: f64) -> [f64; 2] {
+    let half = 0.5 * partition_clear(p.style, depth);
+    [p.u - half - t, p.u + half + t]
+}
+
+/// Heights (v of the underside) of ladder blocks between `v0` and `v1`: every 24 in from
+/// `v0`, each clear of both by at least 2 in.
+fn ladder_heights(v0: f64, v1: f64, t: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut v = v0 + LADDER_STEP;
+    while v + t + 2.0 * INCH <= v1 + 1e-9 {
+        out.push(v);
+        v += LADDER_STEP;
+    }
+    out
 }
 
 /// Frame the wall in `frame`. Pieces come out in one valid assembly order:
@@ -209,7 +304,20 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
     for &row in &spec.detail.blocking_rows {
         check_range(spec, "blocking row height", row, t, stud_top - t)?;
     }
+    if spec.detail.corners == CornerStyle::ThreeStud && stud_top - t < 4.0 * SPACER_BLOCK {
+        return Err(wall_err(
+            spec,
+            format!(
+                "studs {:.4} m long leave no room for a three-stud corner's three {:.3} m spacer blocks",
+                stud_top - t,
+                SPACER_BLOCK
+            ),
+            "make the wall taller or use another corner style",
+        ));
+    }
     let openings = place_openings(spec, stud_top)?;
+    let partitions = place_partitions(spec, &openings)?;
+    let corner = corner_extent(spec.detail.corners, t, depth);
 
     let full_w = [0.0, depth];
     let mut bottoms = Vec::new();
@@ -217,6 +325,7 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
     let mut spanning = Vec::new();
     let mut above = Vec::new();
     let mut records = Vec::new();
+    let mut braces = Vec::new();
     let piece =
         |role, detail: &str, nominal: &str, b| Piece::from_box(&frame, role, detail, nominal, b);
 
@@ -260,11 +369,17 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             k += 1.0;
         }
     }
+    // Framing zones that take the place of studs on centre: openings, partitions, corners.
+    let zones: Vec<[f64; 2]> = openings
+        .iter()
+        .map(|o| o.zone(t))
+        .chain(partitions.iter().map(|p| partition_zone(p, t, depth)))
+        .chain([[0.0, corner], [len - corner, len]])
+        .collect();
     for &c in &grid {
-        let clear = openings.iter().all(|o| {
-            let z = o.zone(t);
-            c + 0.5 * t <= z[0] + 1e-9 || c - 0.5 * t >= z[1] - 1e-9
-        });
+        let clear = zones
+            .iter()
+            .all(|z| c + 0.5 * t <= z[0] + 1e-9 || c - 0.5 * t >= z[1] - 1e-9);
         if clear {
             centres.push(c);
         }
@@ -278,27 +393,139 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         ));
     }
 
+    // Both wall ends' corner framing, mirrored at the far end.
+    let flat_w = [depth - t, depth];
+    for at_end in [false, true] {
+        let span = |u0: f64, u1: f64| {
+            if at_end {
+                [len - u1, len - u0]
+            } else {
+                [u0, u1]
+            }
+        };
+        match spec.detail.corners {
+            CornerStyle::Single => {}
+            CornerStyle::Backer => standing.push(piece(
+                Role::Stud,
+                "corner backer (flat)",
+                nominal,
+                WallBox {
+                    u: span(t, t + depth),
+                    v: [t, stud_top],
+                    w: flat_w,
+                },
+            )),
+            CornerStyle::ThreeStud => {
+                let mid = 0.5 * (t + stud_top);
+                let spacers = [
+                    [t, t + SPACER_BLOCK],
+                    [mid - 0.5 * SPACER_BLOCK, mid + 0.5 * SPACER_BLOCK],
+                    [stud_top - SPACER_BLOCK, stud_top],
+                ];
+                for v in spacers {
+                    standing.push(Piece::standing(
+                        &frame,
+                        Role::Blocking,
+                        "corner spacer",
+                        nominal,
+                        WallBox {
+                            u: span(t, 2.0 * t),
+                            v,
+                            w: full_w,
+                        },
+                    ));
+                }
+                let u = span(2.0 * t, 3.0 * t);
+                standing.push(piece(
+                    Role::Stud,
+                    "corner",
+                    nominal,
+                    stud_box(u[0], t, stud_top),
+                ));
+            }
+            CornerStyle::Ladder => {
+                let u = span(t + LADDER_BAY, 2.0 * t + LADDER_BAY);
+                standing.push(piece(
+                    Role::Stud,
+                    "corner",
+                    nominal,
+                    stud_box(u[0], t, stud_top),
+                ));
+                for v in ladder_heights(t, stud_top, t) {
+                    spanning.push(piece(
+                        Role::Blocking,
+                        "ladder",
+                        nominal,
+                        WallBox {
+                            u: span(t, t + LADDER_BAY),
+                            v: [v, v + t],
+                            w: full_w,
+                        },
+                    ));
+                }
+            }
+        }
+    }
+
+    // Partitions: two studs, and between them a flat backer or ladder blocks.
+    for p in &partitions {
+        let z = partition_zone(p, t, depth);
+        for u0 in [z[0], z[1] - t] {
+            standing.push(piece(
+                Role::Stud,
+                "partition",
+                nominal,
+                stud_box(u0, t, stud_top),
+            ));
+        }
+        let between = [z[0] + t, z[1] - t];
+        match p.style {
+            PartitionStyle::Backer => standing.push(piece(
+                Role::Stud,
+                "partition backer (flat)",
+                nominal,
+                WallBox {
+                    u: between,
+                    v: [t, stud_top],
+                    w: flat_w,
+                },
+            )),
+            PartitionStyle::Ladder => {
+                for v in ladder_heights(t, stud_top, t) {
+                    spanning.push(piece(
+                        Role::Blocking,
+                        "ladder",
+                        nominal,
+                        WallBox {
+                            u: between,
+                            v: [v, v + t],
+                            w: full_w,
+                        },
+                    ));
+                }
+            }
+        }
+    }
+
+    let jacks = spec.header_style != HeaderStyle::Flat;
+    // King stud positions already framed: side by side, two openings share one.
+    let mut kings_framed: Vec<f64> = Vec::new();
     for o in &openings {
         // King studs full height, jacks under the header; a flat header has no jacks and
         // its kings stand at the opening's edges.
-        let jacks = spec.header_style != HeaderStyle::Flat;
-        let (king_left, king_right) = if jacks {
-            (o.u0 - 2.0 * t, o.u1 + t)
-        } else {
-            (o.u0 - t, o.u1)
-        };
-        standing.push(piece(
-            Role::KingStud,
-            "",
-            nominal,
-            stud_box(king_left, t, stud_top),
-        ));
-        standing.push(piece(
-            Role::KingStud,
-            "",
-            nominal,
-            stud_box(king_right, t, stud_top),
-        ));
+        let [king_left, king_right] = o.kings(t, jacks);
+        for u0 in [king_left, king_right] {
+            if kings_framed.iter().any(|k| (k - u0).abs() < 1e-9) {
+                continue;
+            }
+            kings_framed.push(u0);
+            standing.push(piece(
+                Role::KingStud,
+                "",
+                nominal,
+                stud_box(u0, t, stud_top),
+            ));
+        }
         // A king doubled: geometry cannot tell it from a common stud that happens to stand
         // against the king (both run plate to plate, face to face with it), so it is labelled
         // what its geometry says, a stud; only the king meets the jack or the header's end.
@@ -465,10 +692,57 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
         });
     }
 
+    // Let-in braces (last in the assembly order): 45° from the bottom plate's top to the top plate's underside, let into
+    // the outer face of the studs and plates they cross, clear of every opening's framing.
+    for &u in &spec.detail.braces {
+        let brace = Piece::inclined(
+            &frame,
+            Role::Brace,
+            "let in",
+            "1x4",
+            [u, t],
+            [u + (stud_top - t), stud_top],
+            BRACE_WIDTH,
+            [0.0, BRACE_THICKNESS],
+        );
+        let b = brace.wall_box;
+        let blocked = openings
+            .iter()
+            .map(|o| o.zone(t))
+            .find(|z| b.u[0] < z[1] && z[0] < b.u[1]);
+        if !u.is_finite() || b.u[0] < 0.0 || b.u[1] > len || blocked.is_some() {
+            return Err(wall_err(
+                spec,
+                format!(
+                    "a 45° brace from u {u:.4} m runs over u {:.4}..{:.4} m, {}",
+                    b.u[0],
+                    b.u[1],
+                    match blocked {
+                        Some(z) => format!(
+                            "across an opening's framing at u {:.4}..{:.4} m",
+                            z[0], z[1]
+                        ),
+                        None => format!("outside the {len:.4} m wall"),
+                    }
+                ),
+                "a brace needs a stretch of wall as long as the studs are tall, clear of openings",
+            ));
+        }
+        braces.push(brace);
+    }
+
     // Rows of flat blocking in the bays between uprights that cross the row, clear of every
     // sill, header and rough opening.
-    let uprights: Vec<WallBox> = standing.iter().chain(&above).map(|p| p.wall_box).collect();
+    // Posts are uprights through the wall's depth; a flat stud is in the way.
+    let through = |b: &WallBox| b.w[1] - b.w[0] >= depth - 1e-9;
+    let uprights: Vec<WallBox> = standing
+        .iter()
+        .chain(&above)
+        .map(|p| p.wall_box)
+        .filter(through)
+        .collect();
     let mut obstacles: Vec<WallBox> = spanning.iter().map(|p| p.wall_box).collect();
+    obstacles.extend(standing.iter().map(|p| p.wall_box).filter(|b| !through(b)));
     obstacles.extend(openings.iter().map(|o| WallBox {
         u: [o.u0, o.u1],
         v: [o.v0, o.v1],
@@ -525,6 +799,7 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
             ));
         }
     }
+    pieces.extend(braces);
     Ok(WallLayout {
         id: spec.id.clone(),
         name: spec.name.clone(),
@@ -565,6 +840,45 @@ fn blocking_bays(
         .collect()
 }
 
+/// Validate partitions against the wall ends and the openings; sorted by u.
+fn place_partitions(
+    spec: &WallSpec,
+    openings: &[PlacedOpening],
+) -> Result<Vec<PartitionSpec>, SynthError> {
+    let (t, depth) = (spec.lumber.thickness, spec.lumber.width);
+    let end = corner_extent(spec.detail.corners, t, depth);
+    let mut placed: Vec<PartitionSpec> = spec.detail.partitions.clone();
+    placed.sort_by(|a, b| a.u.total_cmp(&b.u));
+    let mut taken: Vec<[f64; 2]> = openings.iter().map(|o| o.zone(t)).collect();
+    for p in &placed {
+        let z = partition_zone(p, t, depth);
+        let err = |what: String| {
+            wall_err(
+                spec,
+                format!("partition at u {:.4} m: {what}", p.u),
+                "move the partition; its two studs need their own place in the wall",
+            )
+        };
+        if !p.u.is_finite() || z[0] < end - 1e-9 || z[1] > spec.length - end + 1e-9 {
+            return Err(err(format!(
+                "its framing u {:.4}..{:.4} m is not clear of the wall ends' framing ({end:.4} m at each end)",
+                z[0], z[1]
+            )));
+        }
+        if let Some(o) = taken
+            .iter()
+            .find(|o| z[0] < o[1] - 1e-9 && o[0] < z[1] - 1e-9)
+        {
+            return Err(err(format!(
+                "its framing u {:.4}..{:.4} m overlaps framing at u {:.4}..{:.4} m",
+                z[0], z[1], o[0], o[1]
+            )));
+        }
+        taken.push(z);
+    }
+    Ok(placed)
+}
+
 /// Validate openings against the wall and each other; sorted by u.
 fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, SynthError> {
     let t = spec.lumber.thickness;
@@ -587,13 +901,14 @@ fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, 
         }
         let (u0, u1) = (o.u, o.u + o.width);
         let beside = if spec.detail.double_kings { 3.0 } else { 2.0 };
-        if u0 - beside * t < t - 1e-9 || u1 + beside * t > spec.length - t + 1e-9 {
+        let end = corner_extent(spec.detail.corners, t, spec.lumber.width);
+        if u0 - beside * t < end - 1e-9 || u1 + beside * t > spec.length - end + 1e-9 {
             return Err(err(
                 format!(
-                    "rough opening u {u0:.4}..{u1:.4} m with its jack and king studs does not fit between the end studs of a {:.4} m wall",
+                    "rough opening u {u0:.4}..{u1:.4} m with its jack and king studs does not fit between the corner framing ({end:.4} m at each end) of a {:.4} m wall",
                     spec.length
                 ),
-                "the opening needs 3 stud thicknesses of wall on each side; move or narrow it",
+                "the opening needs its jack and king studs clear of the wall ends' framing; move or narrow it",
             ));
         }
         let header = header_lumber(o.width).ok_or_else(|| {
@@ -648,14 +963,18 @@ fn place_openings(spec: &WallSpec, stud_top: f64) -> Result<Vec<PlacedOpening>, 
     }
     placed.sort_by(|a, b| a.u0.total_cmp(&b.u0));
     for pair in placed.windows(2) {
-        if pair[0].zone(t)[1] > pair[1].zone(t)[0] + 1e-9 {
+        // Side by side, two openings share the king stud between them.
+        let jacks = spec.header_style != HeaderStyle::Flat;
+        let shared = !spec.detail.double_kings
+            && (pair[0].kings(t, jacks)[1] - pair[1].kings(t, jacks)[0]).abs() < 1e-9;
+        if !shared && pair[0].zone(t)[1] > pair[1].zone(t)[0] + 1e-9 {
             let o = &pair[1];
             return Err(SynthError::Opening {
                 wall: spec.id.clone(),
                 index: o.index,
                 kind: o.spec.kind.name(),
                 what: format!("its framing overlaps opening {}", pair[0].index),
-                hint: "keep 4 stud thicknesses between rough openings".into(),
+                hint: "keep 4 stud thicknesses between rough openings, or exactly 3 (jack, shared king, jack; 1 with flat headers) to share the king stud".into(),
             });
         }
     }

@@ -133,6 +133,7 @@ inputs! {
     "piece_container" => r_piece_container(0: Sym, 1: Sym);
     "piece_material" => r_piece_material(0: Sym, 1: Sym, 2: F64);
     "contact" => r_contact(0: Sym, 1: Sym, 2: Sym, 3: Sym, 4: Sym, 5: F64, 6: Vec3, 7: Vec3);
+    "crossing" => r_crossing(0: Sym, 1: Sym, 2: F64);
     "cell_value" => r_cell_value(0: Sym, 1: F64);
     "cell_choice" => r_cell_choice(0: Sym, 1: Sym);
     "placement_candidate" => r_placement_candidate(0: Sym, 1: F64);
