@@ -176,3 +176,35 @@ fn only_the_relations_the_user_rules_read_are_copied_in() {
     let rules = UserRules::load(&[f], &RuleEngine::Compiled).unwrap();
     assert_eq!(rules.reads(), ["piece_size", "role", "wall_of"]);
 }
+
+/// A pipe (`--rules <(…)`) gives its text to one read only, and the rules are read more than
+/// once: it is refused with what to do, never run as an empty rule file.
+#[test]
+fn a_rule_file_that_is_a_pipe_is_refused() {
+    use std::io::Write;
+    let model =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/synth_wall_door_window_in.ifc");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .arg("check")
+        .arg(&model)
+        .args(["--rules", "/dev/stdin"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // A rule that would fire on every piece if it were read.
+    let rules = ".decl warning(p: symbol, kind: symbol, message: symbol)\nwarning(p, \"x\", \"y\") :- wall_of(p, _).\n";
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(rules.as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("/dev/stdin"), "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+    assert!(out.stdout.is_empty());
+}

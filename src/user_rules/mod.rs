@@ -77,14 +77,26 @@ fn check_outside_rules_dir(files: &[PathBuf], base: &RuleEngine) -> Result<(), U
     Ok(())
 }
 
-/// Every user file must be readable (checked up front for a plain message).
+/// Every user file must be a readable file (checked up front for a plain message). A pipe
+/// (`--rules <(…)`) is refused: the rules are read more than once (checks, cache key, load),
+/// and a pipe gives its text only to the first read.
 fn check_readable(files: &[PathBuf]) -> Result<(), UserRulesError> {
     for f in files {
+        let refuse = |message: String| UserRulesError::RuleFile {
+            path: f.clone(),
+            message,
+        };
+        match std::fs::metadata(f) {
+            Err(e) => return Err(refuse(e.to_string())),
+            Ok(m) if !m.is_file() => {
+                return Err(refuse(
+                    "not a regular file (a pipe or a device); save the rules to a file and give its path".into(),
+                ));
+            }
+            Ok(_) => {}
+        }
         if let Err(e) = std::fs::read(f) {
-            return Err(UserRulesError::RuleFile {
-                path: f.clone(),
-                message: e.to_string(),
-            });
+            return Err(refuse(e.to_string()));
         }
     }
     Ok(())
