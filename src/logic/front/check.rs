@@ -308,6 +308,7 @@ impl<'f> Loader<'f> {
             errors: Vec::new(),
             types: BTreeMap::new(),
             agg_counter: 0,
+            arg_counter: 0,
             atom_types: BTreeMap::new(),
         }
         .run(self.items)
@@ -321,6 +322,8 @@ struct Checker<'f> {
     /// User type name → (parent name, is_subtype, span).
     types: BTreeMap<String, TypeDecl>,
     agg_counter: usize,
+    /// Fresh variables standing for expression arguments of body atoms (`__argN`).
+    arg_counter: usize,
     /// Relation name → attribute base types.
     atom_types: BTreeMap<String, Vec<BaseTy>>,
 }
@@ -662,6 +665,9 @@ impl Checker<'_> {
             }
         }
         body.extend(lifted);
+        // An expression argument reading a variable its own atom binds (`e(2*n, n)`) is
+        // matched after the atom binds it: a fresh variable in its place, equal to it.
+        self.lift_self_bound_args(&mut body, false);
         rule.body = body;
         // Relations and arities.
         self.check_atom(&rule.head, rels, idx);
@@ -694,7 +700,35 @@ impl Checker<'_> {
         // Groundedness and evaluation order.
         let head_vars: BTreeSet<String> = rule.head.args.iter().flat_map(expr_vars).collect();
         let mut outside = head_vars.clone();
-        let plan = self.plan(&mut rule.body, &BTreeSet::new(), &mut outside);
+        let errors_before_plan = self.errors.len();
+        let mut plan = self.plan(&mut rule.body, &BTreeSet::new(), &mut outside);
+        // Atoms whose expression arguments read variables only other such atoms bind
+        // (`p(X-1, Y), p(Y-2, X)`): Soufflé grounds them by matching first and checking the
+        // expression after; so do we, by lifting every expression argument out.
+        if plan.is_none() {
+            let mut lifted = rule.body.clone();
+            if self.lift_self_bound_args(&mut lifted, true) {
+                let mut env = Env::new();
+                let mut named: BTreeMap<String, (String, Span)> = BTreeMap::new();
+                let errors = self.errors.split_off(errors_before_plan);
+                self.collect_atom_types(&rule.head, rels, idx, &mut env, &mut named);
+                self.collect_types_in(&lifted, rels, idx, &mut env, &mut named);
+                self.infer_equalities(&lifted, &mut env);
+                self.check_lits(&mut lifted, &mut env);
+                let mut outside = head_vars.clone();
+                let retry = (self.errors.len() == errors_before_plan)
+                    .then(|| self.plan(&mut lifted, &BTreeSet::new(), &mut outside))
+                    .flatten();
+                if retry.is_some() {
+                    rule.body = lifted;
+                    plan = retry;
+                } else {
+                    // The lifted rule fails too: report the rule as written.
+                    self.errors.truncate(errors_before_plan);
+                    self.errors.extend(errors);
+                }
+            }
+        }
         if let Some((plan, bound)) = plan {
             for a in &rule.head.args {
                 for v in expr_vars(a) {
@@ -706,6 +740,57 @@ impl Checker<'_> {
             rule.plan = plan;
         }
         self.errors.len() == before
+    }
+
+    /// Replaces expression arguments of positive atoms (in aggregate bodies too) by fresh
+    /// variables `__argN`, adding `__argN = <expression>` to the same body: all of them when
+    /// `every`, else those reading a variable that the same atom binds as a plain argument.
+    /// Returns whether any was replaced.
+    fn lift_self_bound_args(&mut self, body: &mut Vec<Literal>, every: bool) -> bool {
+        let mut changed = false;
+        let mut added = Vec::new();
+        for l in body.iter_mut() {
+            for e in lit_exprs_mut(l) {
+                if let ExprKind::Agg(a) = &mut e.kind {
+                    changed |= self.lift_self_bound_args(&mut a.body, every);
+                }
+            }
+            let Literal::Pos(atom) = l else {
+                continue;
+            };
+            let plain: BTreeSet<String> = atom
+                .args
+                .iter()
+                .filter_map(|e| match &e.kind {
+                    ExprKind::Var(v) => Some(v.clone()),
+                    _ => None,
+                })
+                .collect();
+            for arg in &mut atom.args {
+                if matches!(
+                    arg.kind,
+                    ExprKind::Var(_) | ExprKind::Wild | ExprKind::Agg(_)
+                ) {
+                    continue;
+                }
+                let vars = expr_vars(arg);
+                if vars.is_empty() || !(every || vars.iter().any(|v| plain.contains(v))) {
+                    continue;
+                }
+                let span = arg.span;
+                let var = Expr {
+                    kind: ExprKind::Var(format!("__arg{}", self.arg_counter)),
+                    span,
+                    ty: None,
+                };
+                self.arg_counter += 1;
+                let expr = std::mem::replace(arg, var.clone());
+                added.push(Literal::Cmp(CmpOp::Eq, var, expr, span));
+                changed = true;
+            }
+        }
+        body.extend(added);
+        changed
     }
 
     fn lift_in_body(&mut self, body: &mut [Literal]) {
@@ -1336,9 +1421,39 @@ impl Checker<'_> {
         let mut remaining: Vec<usize> = (0..body.len()).collect();
         let mut steps = Vec::new();
         while !remaining.is_empty() {
+            // `x = <float>` does not bind `x` while an atom still to come binds it: the atom
+            // matches stored bits, the comparison is IEEE (-0.0 = 0.0, as in Soufflé).
+            let binds_later = |v: &str| {
+                remaining.iter().any(|&j| match &body[j] {
+                    Literal::Pos(a) => a
+                        .args
+                        .iter()
+                        .any(|e| matches!(&e.kind, ExprKind::Var(x) if x == v)),
+                    _ => false,
+                })
+            };
+            let float_eq = |i: usize| {
+                matches!(&body[i], Literal::Cmp(_, a, b, _)
+                    if a.ty == Some(BaseTy::Float) || b.ty == Some(BaseTy::Float))
+            };
             let ready = remaining
                 .iter()
-                .position(|&i| ready_step(&body[i], i, &bound).is_some());
+                .position(|&i| match ready_step(&body[i], i, &bound) {
+                    Some(Step::Assign { var, .. }) => !(float_eq(i) && binds_later(&var)),
+                    Some(_) => true,
+                    None => false,
+                })
+                .or_else(|| {
+                    // Deferred float assignments run when nothing else can.
+                    let scannable = remaining.iter().any(|&i| scannable(&body[i], &bound));
+                    (!scannable)
+                        .then(|| {
+                            remaining
+                                .iter()
+                                .position(|&i| ready_step(&body[i], i, &bound).is_some())
+                        })
+                        .flatten()
+                });
             if let Some(k) = ready {
                 let i = remaining.remove(k);
                 let step = ready_step(&body[i], i, &bound).unwrap();
@@ -1348,19 +1463,7 @@ impl Checker<'_> {
                 steps.push(step);
                 continue;
             }
-            let scan = remaining.iter().position(|&i| match &body[i] {
-                Literal::Pos(a) => {
-                    let mut b = bound.clone();
-                    b.extend(a.args.iter().filter_map(|e| match &e.kind {
-                        ExprKind::Var(v) => Some(v.clone()),
-                        _ => None,
-                    }));
-                    a.args
-                        .iter()
-                        .all(|e| expr_vars(e).iter().all(|v| b.contains(v)))
-                }
-                _ => false,
-            });
+            let scan = remaining.iter().position(|&i| scannable(&body[i], &bound));
             if let Some(k) = scan {
                 let i = remaining.remove(k);
                 if let Literal::Pos(a) = &body[i] {
@@ -1642,6 +1745,24 @@ fn eqrel_rules(rel: &str, span: Span) -> Vec<Rule> {
 }
 
 /// The step a literal can take now, if all it reads is bound.
+/// Whether a positive atom can be matched now: every expression argument reads only bound
+/// variables or the atom's own plain arguments.
+fn scannable(l: &Literal, bound: &BTreeSet<String>) -> bool {
+    match l {
+        Literal::Pos(a) => {
+            let mut b = bound.clone();
+            b.extend(a.args.iter().filter_map(|e| match &e.kind {
+                ExprKind::Var(v) => Some(v.clone()),
+                _ => None,
+            }));
+            a.args
+                .iter()
+                .all(|e| expr_vars(e).iter().all(|v| b.contains(v)))
+        }
+        _ => false,
+    }
+}
+
 fn ready_step(l: &Literal, i: usize, bound: &BTreeSet<String>) -> Option<Step> {
     let all_bound = |vs: Vec<String>| vs.iter().all(|v| bound.contains(v));
     match l {
