@@ -40,19 +40,7 @@ fn roles_on_independently_written_framing_styles() {
     let notes = results["notes"].as_array().unwrap();
     assert!(notes.is_empty(), "{report}");
     let roles = results["roles"].as_object().unwrap();
-    for role in [
-        "bottom_plate",
-        "top_plate",
-        "cap_plate",
-        "stud",
-        "king_stud",
-        "jack_stud",
-        "header",
-        "sill",
-        "cripple_stud",
-        "blocking",
-        "brace",
-    ] {
+    for role in common::FRAMING_ROLES {
         let n = |k: usize| roles[role][k].as_u64().unwrap() as f64;
         let (truth, found, right) = (n(0), n(1), n(2));
         assert!(truth > 0.0, "no {role} in the models\n{report}");

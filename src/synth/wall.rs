@@ -250,13 +250,18 @@ fn partition_zone(p: &PartitionSpec, t: f64, depth: f64) -> [f64; 2] {
     [p.u - half - t, p.u + half + t]
 }
 
-/// Heights (v of the underside) of ladder blocks between `v0` and `v1`: every 24 in from
-/// `v0`, each clear of both by at least 2 in.
-fn ladder_heights(v0: f64, v1: f64, t: f64) -> Vec<f64> {
+/// Ladder blocks (lumber `t` thick laid flat, the wall's `depth` across) filling the bay `u`
+/// every 24 in up from the bottom plate's top `t`, each at least 2 in under the top plate at
+/// `stud_top`.
+fn ladder_blocks(u: [f64; 2], t: f64, stud_top: f64, depth: f64) -> Vec<WallBox> {
     let mut out = Vec::new();
-    let mut v = v0 + LADDER_STEP;
-    while v + t + 2.0 * INCH <= v1 + 1e-9 {
-        out.push(v);
+    let mut v = t + LADDER_STEP;
+    while v + t + 2.0 * INCH <= stud_top + 1e-9 {
+        out.push(WallBox {
+            u,
+            v: [v, v + t],
+            w: [0.0, depth],
+        });
         v += LADDER_STEP;
     }
     out
@@ -451,17 +456,8 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
                     nominal,
                     stud_box(u[0], t, stud_top),
                 ));
-                for v in ladder_heights(t, stud_top, t) {
-                    spanning.push(piece(
-                        Role::Blocking,
-                        "ladder",
-                        nominal,
-                        WallBox {
-                            u: span(t, t + LADDER_BAY),
-                            v: [v, v + t],
-                            w: full_w,
-                        },
-                    ));
+                for b in ladder_blocks(span(t, t + LADDER_BAY), t, stud_top, depth) {
+                    spanning.push(piece(Role::Blocking, "ladder", nominal, b));
                 }
             }
         }
@@ -491,17 +487,8 @@ pub fn frame_wall(spec: &WallSpec, frame: WallFrame) -> Result<WallLayout, Synth
                 },
             )),
             PartitionStyle::Ladder => {
-                for v in ladder_heights(t, stud_top, t) {
-                    spanning.push(piece(
-                        Role::Blocking,
-                        "ladder",
-                        nominal,
-                        WallBox {
-                            u: between,
-                            v: [v, v + t],
-                            w: full_w,
-                        },
-                    ));
+                for b in ladder_blocks(between, t, stud_top, depth) {
+                    spanning.push(piece(Role::Blocking, "ladder", nominal, b));
                 }
             }
         }

@@ -10,6 +10,21 @@ pub mod skip;
 
 use std::path::{Path, PathBuf};
 
+/// Every role a framing piece can have (`other` aside).
+pub const FRAMING_ROLES: [&str; 11] = [
+    "bottom_plate",
+    "top_plate",
+    "cap_plate",
+    "stud",
+    "king_stud",
+    "jack_stud",
+    "header",
+    "sill",
+    "cripple_stud",
+    "blocking",
+    "brace",
+];
+
 /// `../shared/<relative>` when it exists; otherwise None, after saying what is skipped.
 pub fn shared_path(relative: &str) -> Option<PathBuf> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
