@@ -74,6 +74,9 @@ const BITWISE: [&str; 11] = [
 const MAX_NESTING: usize = 100;
 const MAX_OPERATORS: usize = 1000;
 
+/// Clauses a negated compound condition may expand into (De Morgan's laws).
+const MAX_NEGATED_CLAUSES: usize = 64;
+
 /// A parenthesised disjunction read: the token position after it and its literals.
 type Group = (usize, Vec<Vec<Literal>>);
 
@@ -588,34 +591,55 @@ impl<'a> Parser<'a> {
         if self.is("!") {
             let bang = self.bump().span;
             let inner = self.term()?;
-            if inner.len() != 1 || inner[0].len() != 1 {
-                return err(
-                    bang,
-                    "negation of a conjunction or disjunction is not supported",
-                    "negate single atoms or comparisons; introduce a helper relation for a compound condition",
-                );
-            }
-            let lit = inner.into_iter().next().unwrap().pop().unwrap();
-            let neg = match lit {
-                Literal::Pos(a) => Literal::Neg(a),
-                Literal::Cmp(op, a, b, s) => Literal::Cmp(op.negate(), a, b, s),
-                Literal::StrTest {
-                    is_match,
-                    negated,
-                    args,
-                    span,
-                } => Literal::StrTest {
-                    is_match,
-                    negated: !negated,
-                    args,
-                    span,
-                },
-                Literal::Neg(_) => {
-                    return err(bang, "double negation is not supported", "remove both `!`");
+            // De Morgan: not (C1 ; C2 ; …) is (not C1) and (not C2) …, and not (l1, l2, …) is
+            // (not l1) ; (not l2) ; …: one clause per choice of a literal from each Ci.
+            let mut clauses: Vec<Vec<Literal>> = vec![Vec::new()];
+            for conjunction in inner {
+                let mut next = Vec::new();
+                for clause in &clauses {
+                    for lit in &conjunction {
+                        let mut c = clause.clone();
+                        c.push(Self::negated(bang, lit.clone())?);
+                        next.push(c);
+                    }
                 }
-            };
-            return Ok(vec![vec![neg]]);
+                clauses = next;
+                if clauses.len() > MAX_NEGATED_CLAUSES {
+                    return err(
+                        bang,
+                        "this negation expands into too many clauses",
+                        "introduce a helper relation for the compound condition and negate it",
+                    );
+                }
+            }
+            return Ok(clauses);
         }
+        self.positive_term()
+    }
+
+    /// The negation of one literal.
+    fn negated(bang: Span, lit: Literal) -> Result<Literal, ParseError> {
+        Ok(match lit {
+            Literal::Pos(a) => Literal::Neg(a),
+            Literal::Cmp(op, a, b, s) => Literal::Cmp(op.negate(), a, b, s),
+            Literal::StrTest {
+                is_match,
+                negated,
+                args,
+                span,
+            } => Literal::StrTest {
+                is_match,
+                negated: !negated,
+                args,
+                span,
+            },
+            Literal::Neg(_) => {
+                return err(bang, "double negation is not supported", "remove both `!`");
+            }
+        })
+    }
+
+    fn positive_term(&mut self) -> Result<Vec<Vec<Literal>>, ParseError> {
         if self.is("(") {
             // A parenthesised disjunction, unless it is the start of an expression
             // in a comparison such as `(x + 1) < y`.
