@@ -6,6 +6,7 @@ use super::builtin;
 use super::error::CellError;
 use super::ik::IkFailure;
 use super::load::looks_like_path;
+use super::panels::{PanelLimits, PanelMode};
 use super::robot::Robot;
 use super::toml_file;
 use super::tool::Tool;
@@ -32,6 +33,8 @@ struct CellFile {
     floor: FloorSection,
     #[serde(default)]
     motion: MotionSection,
+    #[serde(default)]
+    panels: PanelLimits,
     track: Option<TrackSection>,
 }
 
@@ -387,6 +390,10 @@ pub struct Cell {
     /// The linear track the base rides on, if the cell has one; `robot_base` is then the
     /// base at the carriage's current position.
     pub track: Option<Track>,
+    /// `[panels]`: the limits walls are split to.
+    pub panels: PanelLimits,
+    /// Whether walls are split (`--panels`; not a file key).
+    pub panel_mode: PanelMode,
 }
 
 impl Cell {
@@ -633,6 +640,10 @@ impl Cell {
             positive("accel", tr.accel, 20.0, "a carriage acceleration in m/s²")?;
         }
         coord("floor", "z", &[f.floor.z])?;
+        let carry = carry_length(c2.length, c1.length, c1.width, c1.arrangement);
+        f.panels
+            .check(carry)
+            .map_err(|(key, m)| bad("panels", key, m))?;
 
         // Payload: the tool alone must not exceed it (the lumber comes on top; the executor checks).
         if let Some(payload) = robot.meta.payload
@@ -735,6 +746,8 @@ impl Cell {
                 z: f.floor.z,
             },
             track,
+            panels: f.panels,
+            panel_mode: PanelMode::default(),
         };
         cell.check_pick(&s.pick_heights)
             .map_err(|m| bad("touch_sensor", "pick_offset", m))?;
@@ -812,6 +825,27 @@ fn bounding_radius(shape: &super::shapes::Shape) -> f64 {
         Shape::Cylinder { radius, length } => (radius * radius + length * length / 4.0).sqrt(),
         Shape::Capsule { radius, length } => radius + length / 2.0,
         Shape::Sphere { radius } => radius,
+    }
+}
+
+/// The longest piece the conveyors carry, m: no longer than conveyor 2, nor than conveyor 1's
+/// deck is wide (side by side) or its belt long (end to end).
+fn carry_length(c2_length: f64, c1_length: f64, c1_width: f64, arrangement: Arrangement) -> f64 {
+    c2_length.min(match arrangement {
+        Arrangement::SideBySide => c1_width,
+        Arrangement::EndToEnd => c1_length,
+    })
+}
+
+impl Cell {
+    /// The longest piece this cell's conveyors carry, m.
+    pub fn carry_length(&self) -> f64 {
+        carry_length(
+            self.conveyor2.length,
+            self.conveyor1.length,
+            self.conveyor1.width,
+            self.arrangement,
+        )
     }
 }
 

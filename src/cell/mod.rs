@@ -13,6 +13,7 @@ mod layout;
 mod load;
 mod meta;
 mod opw;
+mod panels;
 mod robot;
 mod shapes;
 pub mod tcp_poses;
@@ -29,6 +30,7 @@ pub use layout::{
     TouchSensor,
 };
 pub use meta::{OpwParams, RobotMeta};
+pub use panels::{PanelLimits, PanelMode};
 pub use robot::{Inertial, Joint, JointKind, Link, Robot};
 pub use shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};
 pub use tool::{Gripper, Tool, ToolPart};

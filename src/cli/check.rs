@@ -3,7 +3,7 @@
 //! rule found a violation, 2 for bad input (model, cell, rule files).
 
 use super::{CmdResult, Failure, print_stdout};
-use framewright::cell::Cell;
+use framewright::cell::{Cell, PanelMode};
 use framewright::frame::cell_facts::cell_facts;
 use framewright::frame::placement::add_placement_facts;
 use framewright::frame::{Facts, RuleEngine, model_facts, reason};
@@ -52,6 +52,10 @@ pub struct ReasoningInputs {
     /// to the wall's bottom edge, or `auto` (each wall where the arm reaches most of it).
     #[arg(long, value_name = "M|auto")]
     pub offset_x: Option<String>,
+    /// Split walls into panels the cell builds (`auto`, rules/panels.dl, a wall that fits is
+    /// one panel) or keep every wall one panel (`off`).
+    #[arg(long, value_name = "auto|off", default_value = "auto", value_parser = PanelMode::parse)]
+    pub panels: PanelMode,
 }
 
 impl ReasoningInputs {
@@ -103,7 +107,8 @@ pub fn load_model_facts(
         )));
     }
     let model = Model::open(model)?;
-    let cell = load_cell(&inputs.cell, inputs.offset_x.as_deref())?;
+    let mut cell = load_cell(&inputs.cell, inputs.offset_x.as_deref())?;
+    cell.panel_mode = inputs.panels;
     let contacts = ContactOptions {
         tolerance: contact_tolerance_mm / 1000.0,
         ..ContactOptions::default()
@@ -147,7 +152,8 @@ pub fn run(args: CheckArgs) -> CmdResult {
             .tolerance_for_executor("leave out --simulate to check the plan with this tolerance")?;
         // The executor reads the model and reasons itself.
         let model = Model::open(&args.model)?;
-        let cell = load_cell(&args.inputs.cell, args.inputs.offset_x.as_deref())?;
+        let mut cell = load_cell(&args.inputs.cell, args.inputs.offset_x.as_deref())?;
+        cell.panel_mode = args.inputs.panels;
         let options = SimOptions {
             walls: args.walls.clone(),
             engine: base.clone(),

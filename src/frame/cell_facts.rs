@@ -25,6 +25,9 @@
 //! | `conveyor2_x`, `_y`, `_z`, `_yaw`, `_length`, `_width`, `_speed` | value | the same for conveyor 2 |
 //! | `tool_mass` | value | mass of the end effector, kg |
 //! | `gripper_spacing`, `gripper_open_width`, `gripper_closed_width` | value | the tool's grippers (absent for a tool without) |
+//! | `carry_length` | value | the longest piece the conveyors carry (conveyor 2's length, conveyor 1's width side by side or length end to end) |
+//! | `panel_max_length`, `panel_max_height`, `panel_max_mass`, `panel_min_length` | value | `[panels]` of the cell file (m, kg) |
+//! | `panels` | choice | `auto` (walls split into panels by `rules/panels.dl`) or `off` (`--panels off`: every wall one panel) |
 //! | `cell_name`, `robot_name`, `tool_name` | choice | names, for messages |
 
 use super::facts::Facts;
@@ -72,6 +75,12 @@ pub fn cell_facts(cell: &Cell) -> Facts {
         value("gripper_open_width", g.open_width);
         value("gripper_closed_width", g.closed_width);
     }
+    value("carry_length", cell.carry_length());
+    let p = &cell.panels;
+    value("panel_max_length", p.max_length);
+    value("panel_max_height", p.max_height);
+    value("panel_max_mass", p.max_mass);
+    value("panel_min_length", p.min_length);
 
     let mut choice = |key: &str, s: &str| {
         facts.add(
@@ -101,6 +110,7 @@ pub fn cell_facts(cell: &Cell) -> Facts {
             Arrangement::SideBySide => "side_by_side",
         },
     );
+    choice("panels", cell.panel_mode.as_str());
     choice("cell_name", &cell.name);
     choice("robot_name", &cell.robot.name);
     choice("tool_name", &cell.tool.name);

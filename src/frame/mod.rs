@@ -6,6 +6,7 @@ pub mod cell_facts;
 pub mod containers;
 pub mod facts;
 pub mod limits;
+pub mod panels;
 pub mod partition;
 pub mod placement;
 pub mod plan;

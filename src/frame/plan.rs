@@ -2,6 +2,8 @@
 //! members with roles, assembly order, precedence, nailing and framing targets.
 
 use super::Reasoned;
+use super::panels::{self, WallPanels};
+use crate::cell::PanelLimits;
 use crate::geom::Point3;
 use crate::ifc::Model;
 use crate::logic::Value;
@@ -19,6 +21,9 @@ pub struct Plan {
     /// Mass of each piece, kg.
     pub masses: BTreeMap<String, f64>,
     pub warnings: Vec<String>,
+    /// The panel limits the rules derived for the cell (`panel_limit`); None when the
+    /// relations hold none (a rules directory without `panels.dl`).
+    pub panel_limits: Option<PanelLimits>,
 }
 
 #[derive(Debug, Clone)]
@@ -40,6 +45,8 @@ pub struct Wall {
     pub precedence: Vec<(String, String, String)>,
     pub nailing_targets: Vec<NailingTarget>,
     pub framing_targets: Vec<(String, Isometry3<f64>)>,
+    /// The wall split into the panels the cell builds (one when it fits).
+    pub panels: WallPanels,
 }
 
 #[derive(Debug, Clone)]
@@ -241,12 +248,17 @@ impl Plan {
                             .into_iter()
                             .map(|(p, pose)| (p.to_string(), pose))
                             .collect(),
+                        panels: WallPanels::default(),
                     }
                 })
                 .collect();
             walls
         };
-        let ((roles, masses), walls) = rayon::join(piece_maps, build_walls);
+        let ((roles, masses), mut walls) = rayon::join(piece_maps, build_walls);
+        let panel_limits = panels::limits_from(relations);
+        if let Some(limits) = &panel_limits {
+            panels::split_walls(&mut walls, relations, &roles, &masses, limits);
+        }
         let wall_ids: FxHashMap<&str, &str> = walls
             .iter()
             .map(|w| (w.key.as_str(), w.id.as_str()))
@@ -264,6 +276,19 @@ impl Plan {
                 format!("{subject}: {}", sym(&t[1]))
             })
             .collect();
+        for wall in &walls {
+            let split = &wall.panels;
+            warnings.extend(split.notes.iter().map(|n| format!("{}: {n}", wall.id)));
+            for panel in &split.panels {
+                if !panel.exceeds.is_empty() {
+                    warnings.push(format!(
+                        "{}: the panel exceeds the cell's panel limits: {}",
+                        panel.id,
+                        panel.exceeds.join(", ")
+                    ));
+                }
+            }
+        }
         if walls.is_empty() {
             warnings.push(no_walls_reason(model, relations));
         }
@@ -273,6 +298,7 @@ impl Plan {
             roles,
             masses,
             warnings,
+            panel_limits,
         }
     }
 }

@@ -20,6 +20,14 @@ pub const PLAN: &[&str] = &[
     "lumber",
     "across",
     "coplanar",
+    "panel_limit",
+    "wall_split",
+    "local_box",
+    "cut_at_break",
+    "break_allowed",
+    "break_added",
+    "break_wanted",
+    "break_blocked",
 ];
 
 /// A storey's reach (the plan cache checks its entries against it).

@@ -7,6 +7,7 @@ pub mod html;
 pub mod inspect;
 pub mod markup_text;
 mod mesh;
+pub mod panels;
 pub mod plan;
 pub mod png;
 mod pretty_json;

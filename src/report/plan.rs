@@ -1,6 +1,7 @@
 //! The `plan` report (DESIGN §8): members with wall and role, walls with
 //! frame, assembly order, precedence, nailing and framing targets.
 
+use super::panels::{BreakRow, LimitsRow, PanelRow, break_rows, panel_rows, text_line};
 use super::{round_m, round_point};
 use crate::frame::plan::Plan;
 use crate::ifc::{LengthUnit, Model};
@@ -17,6 +18,9 @@ pub struct PlanReport<'a> {
     pub members: Vec<MemberRow<'a>>,
     pub walls: Vec<WallRow<'a>>,
     pub warnings: Vec<String>,
+    /// The panel limits walls were split to (absent when the rules derive none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub panel_limits: Option<LimitsRow>,
     /// Walls reasoned and walls read from the cache (absent without a cache).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cache: Option<crate::cache::CacheCounts>,
@@ -59,6 +63,12 @@ pub struct WallRow<'a> {
     pub precedence: Vec<PrecedenceRow<'a>>,
     pub nailing_targets: Vec<NailRow<'a>>,
     pub framing_targets: Vec<FramingRow<'a>>,
+    /// The wall split into panels the cell builds (one when it fits).
+    pub panels: Vec<PanelRow<'a>>,
+    pub panel_breaks: Vec<BreakRow<'a>>,
+    /// The text report's line on the panels (split walls only).
+    #[serde(skip)]
+    pub panels_line: Option<String>,
 }
 
 #[derive(Debug, Serialize)]
@@ -243,6 +253,9 @@ impl<'a> PlanReport<'a> {
                             }
                         })
                         .collect(),
+                    panels: panel_rows(&w.panels),
+                    panel_breaks: break_rows(&w.panels),
+                    panels_line: text_line(&w.panels),
                 }
             })
             .collect();
@@ -254,6 +267,7 @@ impl<'a> PlanReport<'a> {
             members,
             walls,
             warnings,
+            panel_limits: plan.panel_limits.as_ref().map(LimitsRow::new),
             cache: None,
             role_check: None,
         }
@@ -268,6 +282,7 @@ impl<'a> PlanReport<'a> {
             members: Vec::new(),
             walls: Vec::new(),
             warnings: self.warnings.clone(),
+            panel_limits: self.panel_limits,
             cache: self.cache,
             role_check: self.role_check,
         };
@@ -310,6 +325,9 @@ impl<'a> PlanReport<'a> {
                 w.nailing_targets.len(),
                 roles.join(", ")
             );
+            if let Some(line) = w.panels_line.as_deref() {
+                let _ = writeln!(out, "{line}");
+            }
         }
         for warning in &self.warnings {
             let _ = writeln!(out, "warning: {warning}");

@@ -161,6 +161,14 @@ outputs! {
     "across" => r_across(0, 1);
     "coplanar" => r_coplanar(0, 1);
     "storey_reach" => r_storey_reach(0, 1, 2, 3);
+    "panel_limit" => r_panel_limit(0, 1, 2, 3);
+    "wall_split" => r_wall_split(0);
+    "local_box" => r_local_box(0, 1, 2, 3, 4, 5, 6);
+    "cut_at_break" => r_cut_at_break(0);
+    "break_allowed" => r_break_allowed(0, 1);
+    "break_added" => r_break_added(0, 1, 2, 3);
+    "break_wanted" => r_break_wanted(0, 1, 2);
+    "break_blocked" => r_break_blocked(0, 1, 2, 3);
     "placement_target_at_zero" => r_placement_target_at_zero(0, 1);
     "placement_nail_at_zero" => r_placement_nail_at_zero(0, 1, 2, 3, 4, 5, 6);
 }
@@ -318,5 +326,24 @@ mod tests {
         by_value.sort();
         typed.sort_unstable();
         assert_eq!(typed.iter().map(as_values).collect::<Vec<_>>(), by_value);
+    }
+}
+
+#[cfg(test)]
+mod reads_are_outputs {
+    use super::OUTPUTS;
+    use crate::frame::rule_reads::{PLACEMENT_FIRST_PASS, PLAN, STOREY_REACH};
+
+    /// A relation `plan` reads but the typed runner cannot give sends every plan through the
+    /// whole rule base (twice as slow on a large model, with the same answer).
+    #[test]
+    fn every_relation_plan_reads_is_a_typed_output() {
+        for name in PLAN
+            .iter()
+            .chain(PLACEMENT_FIRST_PASS)
+            .chain([&STOREY_REACH])
+        {
+            assert!(OUTPUTS.contains(name), "{name} is not in builtin::OUTPUTS");
+        }
     }
 }

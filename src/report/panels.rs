@@ -1,0 +1,146 @@
+//! The panels of the `plan` report: each wall's panels, the breaks between them and the
+//! limits they were split to (`frame::panels`).
+
+use super::round_m;
+use crate::cell::PanelLimits;
+use crate::frame::panels::WallPanels;
+use serde::Serialize;
+
+/// Masses to the gram.
+fn round_kg(x: f64) -> f64 {
+    (x * 1e3).round() / 1e3
+}
+
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct LimitsRow {
+    pub max_length: f64,
+    pub max_height: f64,
+    pub max_mass: f64,
+    pub min_length: f64,
+}
+
+impl LimitsRow {
+    pub fn new(l: &PanelLimits) -> LimitsRow {
+        LimitsRow {
+            max_length: round_m(l.max_length),
+            max_height: round_m(l.max_height),
+            max_mass: round_kg(l.max_mass),
+            min_length: round_m(l.min_length),
+        }
+    }
+}
+
+#[derive(Debug, Serialize)]
+pub struct PanelRow<'a> {
+    pub panel_id: &'a str,
+    pub index: usize,
+    pub u_start: f64,
+    pub u_end: f64,
+    pub length: f64,
+    pub height: f64,
+    pub mass: f64,
+    pub member_ids: &'a [String],
+    pub cut_pieces: Vec<CutRow<'a>>,
+    pub added_pieces: Vec<AddedRow<'a>>,
+    /// The limits the panel breaks, in words (empty when it fits).
+    pub exceeds: &'a [String],
+}
+
+#[derive(Debug, Serialize)]
+pub struct CutRow<'a> {
+    pub id: &'a str,
+    pub of: &'a str,
+    pub u_start: f64,
+    pub u_end: f64,
+    pub length: f64,
+    pub mass: f64,
+}
+
+#[derive(Debug, Serialize)]
+pub struct AddedRow<'a> {
+    pub id: &'a str,
+    pub role: &'a str,
+    /// The stud it copies (same section and height), moved along the wall.
+    pub of: &'a str,
+    pub u_start: f64,
+    pub u_end: f64,
+    pub mass: f64,
+}
+
+#[derive(Debug, Serialize)]
+pub struct BreakRow<'a> {
+    pub u: f64,
+    pub reason: &'a str,
+}
+
+pub fn panel_rows(split: &WallPanels) -> Vec<PanelRow<'_>> {
+    split
+        .panels
+        .iter()
+        .map(|p| PanelRow {
+            panel_id: &p.id,
+            index: p.index,
+            u_start: round_m(p.u_start),
+            u_end: round_m(p.u_end),
+            length: round_m(p.length()),
+            height: round_m(p.height),
+            mass: round_kg(p.mass),
+            member_ids: &p.member_ids,
+            cut_pieces: p
+                .cut_pieces
+                .iter()
+                .map(|c| CutRow {
+                    id: &c.id,
+                    of: &c.of,
+                    u_start: round_m(c.u_start),
+                    u_end: round_m(c.u_end),
+                    length: round_m(c.u_end - c.u_start),
+                    mass: round_kg(c.mass),
+                })
+                .collect(),
+            added_pieces: p
+                .added_pieces
+                .iter()
+                .map(|a| AddedRow {
+                    id: &a.id,
+                    role: &a.role,
+                    of: &a.of,
+                    u_start: round_m(a.u_start),
+                    u_end: round_m(a.u_end),
+                    mass: round_kg(a.mass),
+                })
+                .collect(),
+            exceeds: &p.exceeds,
+        })
+        .collect()
+}
+
+pub fn break_rows(split: &WallPanels) -> Vec<BreakRow<'_>> {
+    split
+        .breaks
+        .iter()
+        .map(|b| BreakRow {
+            u: round_m(b.u),
+            reason: &b.reason,
+        })
+        .collect()
+}
+
+/// One line per split wall for the text report: its panels' lengths and where the breaks lie.
+pub fn text_line(split: &WallPanels) -> Option<String> {
+    if split.panels.len() < 2 {
+        return None;
+    }
+    let lengths: Vec<String> = split
+        .panels
+        .iter()
+        .map(|p| format!("{:.2}", p.length()))
+        .collect();
+    let at: Vec<String> = split.breaks.iter().map(|b| format!("{:.3}", b.u)).collect();
+    Some(format!(
+        "  {} panels of {} m, split at u = {} m",
+        split.panels.len(),
+        lengths.join(", "),
+        at.join(", ")
+    ))
+}
