@@ -646,3 +646,100 @@ fn a_shop_rule_forbids_breaks_and_the_interpreter_agrees() {
         "without the rule a break lies near mid-wall ({before:?}): the rule must change something"
     );
 }
+
+fn stdout_of(args: &[&str]) -> String {
+    let out = framewright(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn why_explains_panels_segments_added_studs_and_breaks_not_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let ifc = dir.path().join("w14.ifc");
+    let m = ifc.to_str().unwrap();
+    // 14 m with a window across the middle: two panels would need a break in it.
+    stdout_of(&[
+        "synth",
+        "wall",
+        "--length",
+        "14",
+        "--window",
+        "6.4,1.2,1.2,0.9",
+        "-o",
+        m,
+    ]);
+    let plan = plan(&ifc, &[]);
+    let wall = &plan["walls"][0];
+    let panels = wall["panels"].as_array().unwrap();
+    assert_eq!(panels.len(), 3, "no break allowed between 6.5 and 7.5 m");
+    let second = &panels[1];
+    let (a, b) = (f(&second["u_start"]), f(&second["u_end"]));
+
+    let text = stdout_of(&["why", m, "W1-P2"]);
+    assert!(
+        text.starts_with(&format!("panel W1-P2 of wall W1: u = {a:.3} .. {b:.3} m")),
+        "{text}"
+    );
+    assert!(text.contains("split into 3 panels"), "{text}");
+    assert!(
+        text.contains("at most 7.500 m (what its conveyors carry"),
+        "{text}"
+    );
+    for brk in wall["panel_breaks"].as_array().unwrap() {
+        assert!(text.contains(brk["reason"].as_str().unwrap()), "{text}");
+    }
+
+    let segment = second["cut_pieces"][0]["id"].as_str().unwrap();
+    let text = stdout_of(&["why", m, segment]);
+    assert!(
+        text.contains("a segment of") && text.contains("in panel W1-P2"),
+        "{text}"
+    );
+    let added = panels
+        .iter()
+        .flat_map(|p| p["added_pieces"].as_array().unwrap())
+        .next()
+        .expect("a break beside a single stud adds one");
+    let text = stdout_of(&["why", m, added["id"].as_str().unwrap(), "--json"]);
+    let answer: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(answer["kind"], "added_piece");
+    assert!(
+        answer["explanation"][0]
+            .as_str()
+            .unwrap()
+            .contains(added["of"].as_str().unwrap())
+    );
+
+    // In the window: the break would run through its header and sill.
+    let text = stdout_of(&["why-not", m, "panel_break(W1, 7.0)"]);
+    assert!(
+        text.contains("would run through") && text.contains("(header,") && text.contains("(sill,"),
+        "{text}"
+    );
+    // At the break made.
+    let made = f(&wall["panel_breaks"][0]["u"]);
+    let text = stdout_of(&["why-not", m, &format!("panel_break(W1, {made})")]);
+    assert!(
+        text.starts_with(&format!("W1 is split at u = {made:.3} m")),
+        "{text}"
+    );
+    // Near the king studs: not allowed, the opening's framing stays whole.
+    let text = stdout_of(&["why-not", m, "panel_break(W1, 6.45)"]);
+    assert!(
+        text.contains("not allowed: an opening's framing stays in one panel"),
+        "{text}"
+    );
+
+    // Unknown ones are refused, naming what exists.
+    let out = framewright(&["why", m, "W1-P9"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("names no panel"));
+    let out = framewright(&["why-not", m, "panel_break(W7, 1.0)"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no wall `W7`"));
+}

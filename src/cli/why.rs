@@ -5,8 +5,12 @@
 
 use super::check::{ReasoningInputs, load_inputs, load_model_facts, rule_base};
 use super::{CmdResult, Failure, print_stdout};
+use framewright::frame::RuleLimits;
 use framewright::frame::containers::{containers_of, restrict_to_containers};
-use framewright::frame::placement::add_placement_facts;
+use framewright::frame::panel_why;
+use framewright::frame::placement::{add_placement_facts, reason_placed};
+use framewright::frame::plan::Plan;
+use framewright::logic::compiled::Relations;
 use framewright::user_rules::render::{render_why, render_why_not};
 use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
 use framewright::user_rules::why::{
@@ -20,7 +24,8 @@ use std::path::PathBuf;
 pub struct WhyArgs {
     /// The IFC model.
     pub model: PathBuf,
-    /// A piece id, an IFC GlobalId or an entity `#id`.
+    /// A piece id, an IFC GlobalId or an entity `#id`; or a panel (`W1-P2`), a plate segment
+    /// (`PLATE~2`) or an added end stud (`STUD~end2`) of the plan.
     pub id: String,
     #[command(flatten)]
     pub common: Common,
@@ -30,7 +35,8 @@ pub struct WhyArgs {
 pub struct WhyNotArgs {
     /// The IFC model.
     pub model: PathBuf,
-    /// The tuple, e.g. 'role(#47, king_stud)' (`#id` stands for the piece of that entity).
+    /// The tuple, e.g. 'role(#47, king_stud)' (`#id` stands for the piece of that entity); or
+    /// 'panel_break(W1, 7.0)': why a wall is not split at u = 7.0 m.
     pub tuple: String,
     #[command(flatten)]
     pub common: Common,
@@ -146,6 +152,17 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     c.check_simulation()?;
     let base = rule_base(&c.inputs.rules_dir);
     let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
+    // A panel, a plate segment or an added stud: not a piece of the model but of the plan.
+    if panel_why::names_a_panel_part(&args.id) && resolve_element(&model, &args.id).is_err() {
+        let (plan, _) = plan_of(facts, &cell, &base, &model)?;
+        let answer = panel_why::why(&plan, &cell, &args.id).ok_or_else(|| {
+            Failure::bad_input(format!(
+                "`{}` names no panel, plate segment or added stud of the plan (panels are WALL-Pn, segments PLATE~k, added studs STUD~endN; `framewright plan --json` lists them)",
+                args.id
+            ))
+        })?;
+        return print_panel_answer(&args, &cell.name, &args.id, &answer);
+    }
     // Only the element's containers matter (see `frame::containers`): the placement search
     // and the rules run over them alone.
     let pieces = resolve_element(&model, &args.id).map_err(failure)?;
@@ -208,6 +225,24 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     let c = &args.common;
     c.check_simulation()?;
     let base = rule_base(&c.inputs.rules_dir);
+    if let Some(query) = panel_why::parse_break_query(&args.tuple) {
+        let (wall, u) = query.map_err(Failure::bad_input)?;
+        let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
+        let (plan, relations) = plan_of(facts, &cell, &base, &model)?;
+        let answer = panel_why::why_no_break(&plan, &relations, &cell, &wall, u)
+            .map_err(Failure::bad_input)?;
+        let text = if c.json {
+            json(&Envelope {
+                model: args.model.display().to_string(),
+                cell: &cell.name,
+                query: &args.tuple,
+                answer: &answer,
+            })?
+        } else {
+            answer.to_text()
+        };
+        return print_stdout(&text);
+    }
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
     let ids = piece_ids_in(&model, &args.tuple);
     simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
@@ -227,6 +262,38 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
         })?
     } else {
         render_why_not(&args.tuple, &report)
+    };
+    print_stdout(&text)
+}
+
+/// The plan of the model on the cell, with the relations it came from.
+fn plan_of(
+    facts: framewright::frame::Facts,
+    cell: &framewright::cell::Cell,
+    base: &framewright::frame::RuleEngine,
+    model: &framewright::ifc::Model,
+) -> Result<(Plan, Relations), Failure> {
+    let limits = RuleLimits::from_env()?;
+    let reasoned = reason_placed(facts, cell, base, Plan::RELATIONS, &limits)?;
+    let plan = Plan::from_reasoned(model, &reasoned);
+    Ok((plan, reasoned.relations))
+}
+
+fn print_panel_answer(
+    args: &WhyArgs,
+    cell: &str,
+    query: &str,
+    answer: &panel_why::PanelWhy,
+) -> CmdResult {
+    let text = if args.common.json {
+        json(&Envelope {
+            model: args.model.display().to_string(),
+            cell,
+            query,
+            answer,
+        })?
+    } else {
+        answer.to_text()
     };
     print_stdout(&text)
 }

@@ -6,6 +6,7 @@ pub mod cell_facts;
 pub mod containers;
 pub mod facts;
 pub mod limits;
+pub mod panel_why;
 pub mod panels;
 pub mod partition;
 pub mod placement;

@@ -22,7 +22,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use std::collections::BTreeMap;
 
 /// Faces closer than this meet, m (`break_tolerance` of the rules).
-const TOLERANCE: f64 = 0.003;
+pub(crate) const TOLERANCE: f64 = 0.003;
 
 /// One piece of a wall as the panel split sees it (wall coordinates, m).
 #[derive(Debug, Clone)]
@@ -606,6 +606,92 @@ pub fn limits_from(relations: &Relations) -> Option<PanelLimits> {
     })
 }
 
+/// The rules' break relations, by wall key, and the pieces' extents in their walls.
+pub struct BreakIndex<'r> {
+    boxes: FxHashMap<&'r str, [f64; 6]>,
+    cut: FxHashSet<&'r str>,
+    by_wall: FxHashMap<&'r str, WallBreaks<'r>>,
+    none: WallBreaks<'r>,
+}
+
+fn sym(v: &Value) -> &str {
+    v.as_symbol().unwrap_or_default()
+}
+
+fn float(v: &Value) -> f64 {
+    v.as_float().unwrap_or(f64::NAN)
+}
+
+impl<'r> BreakIndex<'r> {
+    pub fn new(relations: &'r Relations) -> BreakIndex<'r> {
+        let get = |relation: &str| relations.get(relation).map_or(&[][..], Vec::as_slice);
+        let boxes = get("local_box")
+            .iter()
+            .map(|t| (sym(&t[0]), std::array::from_fn(|i| float(&t[i + 1]))))
+            .collect();
+        let cut = get("cut_at_break").iter().map(|t| sym(&t[0])).collect();
+        let mut by_wall: FxHashMap<&str, WallBreaks> = FxHashMap::default();
+        fn wall<'m, 'r>(
+            by_wall: &'m mut FxHashMap<&'r str, WallBreaks<'r>>,
+            t: &'r [Value],
+        ) -> &'m mut WallBreaks<'r> {
+            by_wall.entry(sym(&t[0])).or_default()
+        }
+        for t in get("wall_split") {
+            wall(&mut by_wall, t).split = true;
+        }
+        for t in get("break_allowed") {
+            wall(&mut by_wall, t).allowed.push(float(&t[1]));
+        }
+        for t in get("break_added") {
+            let side = t[3].as_number().unwrap_or(0);
+            wall(&mut by_wall, t)
+                .added
+                .push((float(&t[1]), sym(&t[2]), side));
+        }
+        for t in get("break_wanted") {
+            wall(&mut by_wall, t)
+                .wanted
+                .push((float(&t[1]), sym(&t[2])));
+        }
+        for t in get("break_blocked") {
+            wall(&mut by_wall, t)
+                .blocked
+                .push((float(&t[1]), sym(&t[2]), sym(&t[3])));
+        }
+        BreakIndex {
+            boxes,
+            cut,
+            by_wall,
+            none: WallBreaks::default(),
+        }
+    }
+
+    /// What the rules say about the wall named by its key piece.
+    pub fn breaks(&self, key: &str) -> &WallBreaks<'r> {
+        self.by_wall.get(key).unwrap_or(&self.none)
+    }
+
+    /// The wall's members as the split sees them.
+    pub fn pieces<'w>(&self, wall: &'w Wall, masses: &BTreeMap<String, f64>) -> Vec<PieceSpan<'w>> {
+        wall.members
+            .iter()
+            .map(|id| {
+                let b = self.boxes.get(id.as_str()).copied().unwrap_or([0.0; 6]);
+                PieceSpan {
+                    id,
+                    u0: b[0],
+                    u1: b[1],
+                    v0: b[2],
+                    v1: b[3],
+                    mass: masses.get(id).copied().unwrap_or(0.0),
+                    cut: self.cut.contains(id.as_str()),
+                }
+            })
+            .collect()
+    }
+}
+
 /// Splits every wall of the plan (`Wall::panels`) from the rules' break relations.
 pub(super) fn split_walls(
     walls: &mut [Wall],
@@ -615,69 +701,11 @@ pub(super) fn split_walls(
     limits: &PanelLimits,
 ) {
     use rayon::prelude::*;
-    let get = |relation: &str| relations.get(relation).map_or(&[][..], Vec::as_slice);
-    fn sym(v: &Value) -> &str {
-        v.as_symbol().unwrap_or_default()
-    }
-    let float = |v: &Value| v.as_float().unwrap_or(f64::NAN);
-    let boxes: FxHashMap<&str, [f64; 6]> = get("local_box")
-        .iter()
-        .map(|t| (sym(&t[0]), std::array::from_fn(|i| float(&t[i + 1]))))
-        .collect();
-    let cut: FxHashSet<&str> = get("cut_at_break").iter().map(|t| sym(&t[0])).collect();
-    let mut by_wall: FxHashMap<&str, WallBreaks> = FxHashMap::default();
-    for t in get("wall_split") {
-        by_wall.entry(sym(&t[0])).or_default().split = true;
-    }
-    for t in get("break_allowed") {
-        by_wall
-            .entry(sym(&t[0]))
-            .or_default()
-            .allowed
-            .push(float(&t[1]));
-    }
-    for t in get("break_added") {
-        let side = t[3].as_number().unwrap_or(0);
-        by_wall
-            .entry(sym(&t[0]))
-            .or_default()
-            .added
-            .push((float(&t[1]), sym(&t[2]), side));
-    }
-    for t in get("break_wanted") {
-        by_wall
-            .entry(sym(&t[0]))
-            .or_default()
-            .wanted
-            .push((float(&t[1]), sym(&t[2])));
-    }
-    for t in get("break_blocked") {
-        by_wall
-            .entry(sym(&t[0]))
-            .or_default()
-            .blocked
-            .push((float(&t[1]), sym(&t[2]), sym(&t[3])));
-    }
-    let none = WallBreaks::default();
+    let index = BreakIndex::new(relations);
     let role_of = |p: &str| roles.get(p).cloned().unwrap_or_else(|| "other".into());
     walls.par_iter_mut().for_each(|wall| {
-        let pieces: Vec<PieceSpan> = wall
-            .members
-            .iter()
-            .map(|id| {
-                let b = boxes.get(id.as_str()).copied().unwrap_or([0.0; 6]);
-                PieceSpan {
-                    id,
-                    u0: b[0],
-                    u1: b[1],
-                    v0: b[2],
-                    v1: b[3],
-                    mass: masses.get(id).copied().unwrap_or(0.0),
-                    cut: cut.contains(id.as_str()),
-                }
-            })
-            .collect();
-        let breaks = by_wall.get(wall.key.as_str()).unwrap_or(&none);
+        let pieces = index.pieces(wall, masses);
+        let breaks = index.breaks(&wall.key);
         wall.panels = split_wall(&wall.id, wall.length, &pieces, breaks, limits, &role_of);
     });
 }
