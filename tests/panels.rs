@@ -743,3 +743,65 @@ fn why_explains_panels_segments_added_studs_and_breaks_not_made() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no wall `W7`"));
 }
+
+#[test]
+fn the_report_draws_the_breaks_and_lists_the_panels() {
+    let dir = tempfile::tempdir().unwrap();
+    let ifc = dir.path().join("w9.ifc");
+    let m = ifc.to_str().unwrap();
+    stdout_of(&[
+        "synth",
+        "wall",
+        "--length",
+        "9",
+        "--window",
+        "2.0,1.2,1.2,0.9",
+        "-o",
+        m,
+    ]);
+    let plan = plan(&ifc, &[]);
+    let panels = plan["walls"][0]["panels"].as_array().unwrap();
+    assert_eq!(panels.len(), 2, "9 m on a 7.5 m cell");
+    let out = dir.path().join("report");
+    stdout_of(&[
+        "simulate",
+        m,
+        "--no-cache",
+        "--report",
+        out.to_str().unwrap(),
+    ]);
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert_eq!(
+        page.matches("class=\"panel-break\"").count(),
+        panels.len() - 1
+    );
+    assert!(page.contains("<table class=\"panels\">"), "no panel table");
+    for p in panels {
+        let id = p["panel_id"].as_str().unwrap();
+        assert!(page.contains(&format!("<td>{id}</td>")), "no row for {id}");
+        assert!(
+            page.contains(&format!("{id} · {:.2} m", f(&p["length"]))),
+            "no label for {id}"
+        );
+    }
+    // A wall that fits has neither.
+    let one = dir.path().join("w6.ifc");
+    stdout_of(&[
+        "synth",
+        "wall",
+        "--length",
+        "6",
+        "-o",
+        one.to_str().unwrap(),
+    ]);
+    let out = dir.path().join("report6");
+    stdout_of(&[
+        "simulate",
+        one.to_str().unwrap(),
+        "--no-cache",
+        "--report",
+        out.to_str().unwrap(),
+    ]);
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(!page.contains("panel-break") && !page.contains("class=\"panels\""));
+}

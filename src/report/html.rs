@@ -283,6 +283,7 @@ fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
             h3 { "Elevation" }
             p { "Wall frame: u along the wall, v up; hover a piece for its IFC name, entity and reason." }
             (svg::elevation(w))
+            (panels(w))
             (causes(w))
             h3 { "Cell from above" }
             p { "The wall laid on the assembly area; the dashed circle is the grip's reach straight down at the assembly surface." }
@@ -300,6 +301,35 @@ fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
                     }
                 }
             }
+        }
+    }
+}
+
+/// The wall's panels, when it is split: one row each.
+fn panels(w: &WallView) -> Markup {
+    let split = w.panels;
+    html! {
+        @if split.panels.len() > 1 {
+            h3 { "Panels" }
+            p { (format!("The wall is longer or heavier than the cell builds: split into {} panels at the dashed lines (rules/panels.dl; framewright why MODEL {} explains a panel). The run above still frames the wall whole.", split.panels.len(), split.panels[0].id)) }
+            table class="panels" {
+                tr { th { "panel" } th { "u from (m)" } th { "u to (m)" } th { "length (m)" } th { "height (m)" } th { "mass (kg)" } th { "members" } th { "plate segments" } th { "added end studs" } th { "exceeds" } }
+                @for p in &split.panels {
+                    tr {
+                        td { (p.id) }
+                        td class="num" { (format!("{:.3}", p.u_start)) }
+                        td class="num" { (format!("{:.3}", p.u_end)) }
+                        td class="num" { (format!("{:.3}", p.length())) }
+                        td class="num" { (format!("{:.3}", p.height)) }
+                        td class="num" { (format!("{:.1}", p.mass)) }
+                        td class="num" { (p.member_ids.len()) }
+                        td class="num" { (p.cut_pieces.len()) }
+                        td class="num" { (p.added_pieces.len()) }
+                        td { (if p.exceeds.is_empty() { "-".to_string() } else { p.exceeds.join(", ") }) }
+                    }
+                }
+            }
+            @for note in &split.notes { p class="note" { (note) } }
         }
     }
 }

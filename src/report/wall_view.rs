@@ -5,6 +5,7 @@
 use super::causes::{RootCause, root_causes};
 use super::simulate::{SimReport, WallRow};
 use super::verdict;
+use crate::frame::panels::WallPanels;
 use crate::ifc::Model;
 use crate::sim::Simulation;
 use crate::sim::record::{NailOutcome, WallRecord};
@@ -44,6 +45,8 @@ pub struct WallView<'a> {
     pub causes: Vec<RootCause>,
     /// Smallest reach margin of the wall's solved pick and place poses (m).
     pub min_margin: Option<f64>,
+    /// The wall's panels (one when it fits the cell).
+    pub panels: &'a WallPanels,
 }
 
 impl<'a> WallView<'a> {
@@ -156,6 +159,7 @@ impl<'a> WallView<'a> {
             nails,
             causes: root_causes(report, wall_id),
             min_margin,
+            panels: &plan_wall.panels,
         })
     }
 
