@@ -161,7 +161,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
                 args.id
             ))
         })?;
-        return print_panel_answer(&args, &cell.name, &args.id, &answer);
+        return print_panel_answer(c, &args.model, &cell.name, &args.id, &answer);
     }
     // Only the element's containers matter (see `frame::containers`): the placement search
     // and the rules run over them alone.
@@ -231,17 +231,7 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
         let (plan, relations) = plan_of(facts, &cell, &base, &model)?;
         let answer = panel_why::why_no_break(&plan, &relations, &cell, &wall, u)
             .map_err(Failure::bad_input)?;
-        let text = if c.json {
-            json(&Envelope {
-                model: args.model.display().to_string(),
-                cell: &cell.name,
-                query: &args.tuple,
-                answer: &answer,
-            })?
-        } else {
-            answer.to_text()
-        };
-        return print_stdout(&text);
+        return print_panel_answer(c, &args.model, &cell.name, &args.tuple, &answer);
     }
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
     let ids = piece_ids_in(&model, &args.tuple);
@@ -280,14 +270,15 @@ fn plan_of(
 }
 
 fn print_panel_answer(
-    args: &WhyArgs,
+    c: &Common,
+    model: &std::path::Path,
     cell: &str,
     query: &str,
     answer: &panel_why::PanelWhy,
 ) -> CmdResult {
-    let text = if args.common.json {
+    let text = if c.json {
         json(&Envelope {
-            model: args.model.display().to_string(),
+            model: model.display().to_string(),
             cell,
             query,
             answer,
