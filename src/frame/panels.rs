@@ -241,7 +241,8 @@ impl MassIndex {
         for (_, m) in &whole {
             running.push(running.last().copied().unwrap_or(0.0) + m);
         }
-        let mass_of = |id: &str| pieces.iter().find(|p| p.id == id).map_or(0.0, |p| p.mass);
+        let masses: FxHashMap<&str, f64> = pieces.iter().map(|p| (p.id, p.mass)).collect();
+        let mass_of = |id: &str| masses.get(id).copied().unwrap_or(0.0);
         let added = |side: i64| -> Vec<f64> {
             sites
                 .iter()
@@ -527,13 +528,14 @@ fn build_panels(
             spans[k].push((p.v0, p.v1));
         }
     }
+    let by_id: FxHashMap<&str, &PieceSpan> = pieces.iter().map(|p| (p.id, p)).collect();
     for (b, &i) in chosen.iter().enumerate() {
         let site = &sites[i];
         let mut added: Vec<&(f64, &str, i64)> =
             breaks.added.iter().filter(|a| site.holds(a.0)).collect();
         added.sort_by(|x, y| (x.1, x.2).cmp(&(y.1, y.2)));
         for &&(u, stud, side) in &added {
-            let Some(s) = pieces.iter().find(|p| p.id == stud) else {
+            let Some(s) = by_id.get(stud) else {
                 continue;
             };
             let width = s.u1 - s.u0;
