@@ -7,6 +7,7 @@
 
 mod common;
 
+use common::ifc_edit::{move_point, stud_points};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -473,45 +474,6 @@ fn check_panels_unlimited(plan: &Value) -> usize {
 
 /// The model with the stud whose placement point is `point` moved `du` along its wall (a
 /// `--grouping wall` model places members in their wall's frame, x along the wall).
-fn move_point(text: &str, point: &str, du: f64) -> String {
-    let line = text
-        .lines()
-        .find(|l| l.starts_with(&format!("{point}=")))
-        .unwrap();
-    let body = &line[line.find("((").unwrap() + 2..line.find("))").unwrap()];
-    let xyz: Vec<f64> = body.split(',').map(|c| c.trim().parse().unwrap()).collect();
-    let new = format!(
-        "{point}=IFCCARTESIANPOINT(({:?},{:?},{:?}));",
-        xyz[0] + du,
-        xyz[1],
-        xyz[2]
-    );
-    text.replacen(line, &new, 1)
-}
-
-/// The placement points of the model's studs (IfcMember .STUD.), in file order.
-fn stud_points(text: &str) -> Vec<String> {
-    let lines: BTreeMap<&str, &str> = text
-        .lines()
-        .filter_map(|l| l.split_once('='))
-        .filter(|(id, _)| id.starts_with('#'))
-        .collect();
-    let inside = |id: &str| {
-        let body = lines[id.trim()];
-        body[body.find('(').unwrap() + 1..body.rfind(')').unwrap()].to_string()
-    };
-    text.lines()
-        .filter(|l| l.contains("IFCMEMBER(") && l.contains(".STUD."))
-        .map(|l| {
-            let body = l.split_once('=').unwrap().1;
-            let placement = body.split(',').nth(5).unwrap().trim().to_string();
-            let local = inside(&placement);
-            let axis = local.split_once(',').unwrap().1.to_string();
-            inside(&axis).split(',').next().unwrap().trim().to_string()
-        })
-        .collect()
-}
-
 #[test]
 fn moving_one_stud_moves_at_most_the_break_beside_it() {
     let dir = tempfile::tempdir().unwrap();

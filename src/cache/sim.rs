@@ -5,15 +5,11 @@
 use super::key::{build_id, wall_key};
 use super::store::{Cache, Lookup};
 use crate::cell::Cell;
-use crate::frame::plan::Plan;
-use crate::frame::{Facts, cell_facts, model_facts, reason};
-use crate::geom::ContactOptions;
 use crate::ifc::Model;
 use crate::sim::{
-    SimError, SimOptions, Simulation, WallRecord, check_options, select_walls,
-    simulate_with_progress,
+    Prepared, SimError, SimOptions, Simulation, WallRecord, check_options, prepare, run_prepared,
+    select_walls,
 };
-use crate::world::Scene;
 use serde::Serialize;
 
 /// How many walls were simulated and how many came from the cache.
@@ -72,31 +68,25 @@ pub struct ShardRun {
     pub cache: CacheCounts,
 }
 
-/// The model reasoned and its scene built: what every simulation starts from.
-struct Prepared {
-    facts: Facts,
-    scene: Scene,
-    plan: Plan,
+/// A prepared run and the cache keys of its selected walls.
+struct Keyed {
+    prepared: Prepared,
     /// (wall key piece, cache key) of the selected walls, in plan order.
     walls: Vec<(String, String)>,
 }
 
-fn prepare(
+fn prepare_keyed(
     model: &Model,
     model_name: &str,
     cell: &Cell,
     options: &SimOptions,
-) -> Result<Prepared, SimError> {
+) -> Result<Keyed, SimError> {
     check_options(options)?;
-    let mut facts = model_facts(model, &ContactOptions::default());
-    facts.extend(cell_facts(cell));
-    crate::frame::placement::add_placement_facts(&mut facts, cell, &options.engine)?;
-    let planned = reason(&facts, &options.engine, false)?;
-    let scene = Scene::build(model_name, model, cell, &planned)?;
-    let plan = Plan::from_reasoned(model, &planned);
+    let prepared = prepare(model, model_name, cell, &options.engine)?;
+    let (scene, plan) = (&prepared.scene, &prepared.plan);
     let build = build_id();
     let mut walls = Vec::new();
-    for key_piece in select_walls(&plan, &options.walls)? {
+    for key_piece in select_walls(plan, &options.walls)? {
         let (Some(scene_wall), Some(plan_wall)) = (
             scene.walls.iter().find(|w| w.id == key_piece),
             plan.walls.iter().find(|w| w.key == key_piece),
@@ -112,12 +102,7 @@ fn prepare(
         let key = wall_key(build, cell, options, scene_wall, &pieces, plan_wall);
         walls.push((key_piece, key));
     }
-    Ok(Prepared {
-        facts,
-        scene,
-        plan,
-        walls,
-    })
+    Ok(Keyed { prepared, walls })
 }
 
 /// What a cached run must hand back of each wall.
@@ -160,25 +145,20 @@ pub fn simulate_cached_for(
     cache: &Cache,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<(Simulation, CacheCounts), SimError> {
-    let prepared = prepare(model, model_name, cell, options)?;
-    let (found, misses, mut counts) = look_up(cache, &prepared.walls, need);
-    if found.iter().all(Option::is_none) {
-        // Nothing cached: one plain run, whose result is the answer as it stands.
-        let sim = simulate_with_progress(model, model_name, cell, options, progress)?;
-        for record in &sim.records {
-            if let Some((_, key)) = prepared.walls.iter().find(|(k, _)| k == &record.wall) {
-                store(cache, key, record, need);
-            }
-        }
-        counts.computed = sim.records.len();
-        return Ok((sim, counts));
-    }
+    let keyed = prepare_keyed(model, model_name, cell, options)?;
+    let (found, misses, mut counts) = look_up(cache, &keyed.walls, need);
     let mut computed = simulate_misses(
-        model, model_name, cell, options, cache, &misses, need, progress,
+        &keyed.prepared,
+        cell,
+        options,
+        cache,
+        &misses,
+        need,
+        progress,
     )?;
     counts.computed = computed.len();
     let mut records = Vec::with_capacity(found.len());
-    for (record, (key_piece, _)) in found.into_iter().zip(&prepared.walls) {
+    for (record, (key_piece, _)) in found.into_iter().zip(&keyed.walls) {
         match record {
             Some(r) => records.push(r),
             None => {
@@ -190,7 +170,8 @@ pub fn simulate_cached_for(
             }
         }
     }
-    Ok((assemble(prepared, records, options)?, counts))
+    let sim = Simulation::from_prepared(keyed.prepared, records, &options.engine)?;
+    Ok((sim, counts))
 }
 
 /// The simulation of the model when the cache holds every selected wall; None otherwise
@@ -202,25 +183,14 @@ pub fn cached_simulation(
     options: &SimOptions,
     cache: &Cache,
 ) -> Result<Option<Simulation>, SimError> {
-    let prepared = prepare(model, model_name, cell, options)?;
-    let (found, misses, _) = look_up(cache, &prepared.walls, Need::Records);
+    let keyed = prepare_keyed(model, model_name, cell, options)?;
+    let (found, misses, _) = look_up(cache, &keyed.walls, Need::Records);
     if !misses.is_empty() {
         return Ok(None);
     }
     let records = found.into_iter().flatten().collect();
-    Ok(Some(assemble(prepared, records, options)?))
-}
-
-/// The verdicts reasoned over the records (in wall order), as `simulate` reasons them.
-fn assemble(
-    prepared: Prepared,
-    records: Vec<WallRecord>,
-    options: &SimOptions,
-) -> Result<Simulation, SimError> {
-    let Prepared {
-        facts, scene, plan, ..
-    } = prepared;
-    Simulation::from_records(facts, scene, plan, records, &options.engine)
+    let sim = Simulation::from_prepared(keyed.prepared, records, &options.engine)?;
+    Ok(Some(sim))
 }
 
 /// Simulates the walls of one shard that the cache lacks, and stores them.
@@ -233,8 +203,8 @@ pub fn simulate_shard(
     shard: Shard,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<ShardRun, SimError> {
-    let prepared = prepare(model, model_name, cell, options)?;
-    let mine: Vec<(String, String)> = prepared
+    let keyed = prepare_keyed(model, model_name, cell, options)?;
+    let mine: Vec<(String, String)> = keyed
         .walls
         .iter()
         .filter(|(_, key)| shard.holds(key))
@@ -242,8 +212,7 @@ pub fn simulate_shard(
         .collect();
     let (_, misses, mut counts) = look_up(cache, &mine, Need::Records);
     counts.computed = simulate_misses(
-        model,
-        model_name,
+        &keyed.prepared,
         cell,
         options,
         cache,
@@ -254,13 +223,13 @@ pub fn simulate_shard(
     .len();
     let wall_ids = mine
         .iter()
-        .filter_map(|(k, _)| prepared.plan.walls.iter().find(|w| &w.key == k))
+        .filter_map(|(k, _)| keyed.prepared.plan.walls.iter().find(|w| &w.key == k))
         .map(|w| w.id.clone())
         .collect();
     Ok(ShardRun {
         shard: shard.to_string(),
         walls: wall_ids,
-        other_walls: prepared.walls.len() - mine.len(),
+        other_walls: keyed.walls.len() - mine.len(),
         cache: counts,
     })
 }
@@ -311,11 +280,9 @@ fn store(cache: &Cache, key: &str, record: &WallRecord, need: Need) {
     }
 }
 
-/// Simulates the missing walls (in one run) and stores their records.
-#[allow(clippy::too_many_arguments)]
+/// Simulates the missing walls of a prepared run and stores their records.
 fn simulate_misses(
-    model: &Model,
-    model_name: &str,
+    prepared: &Prepared,
     cell: &Cell,
     options: &SimOptions,
     cache: &Cache,
@@ -326,11 +293,8 @@ fn simulate_misses(
     if misses.is_empty() {
         return Ok(Vec::new());
     }
-    let only = SimOptions {
-        walls: misses.iter().map(|(k, _)| k.clone()).collect(),
-        ..options.clone()
-    };
-    let records = simulate_with_progress(model, model_name, cell, &only, progress)?.records;
+    let keys: Vec<String> = misses.iter().map(|(k, _)| k.clone()).collect();
+    let records = run_prepared(prepared, cell, options, &keys, progress)?;
     for r in &records {
         if let Some((_, key)) = misses.iter().find(|(k, _)| k == &r.wall) {
             store(cache, key, r, need);

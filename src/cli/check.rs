@@ -76,6 +76,16 @@ impl ReasoningInputs {
 const DEFAULT_CONTACT_TOLERANCE_MM: f64 = 3.0;
 
 /// Loads a cell and applies a command-line `--offset-x`.
+/// `--panels` for the commands that simulate or build a world.
+#[derive(clap::Args, Clone, Copy)]
+pub struct PanelsArg {
+    /// Split walls into panels the cell builds (`auto`, rules/panels.dl, a wall that fits is
+    /// one panel; each panel is framed and simulated on its own) or keep every wall one panel
+    /// (`off`).
+    #[arg(long, value_name = "auto|off", default_value = "auto", value_parser = PanelMode::parse)]
+    pub panels: PanelMode,
+}
+
 pub fn load_cell(name: &str, offset_x: Option<&str>) -> Result<Cell, Failure> {
     let mut cell = Cell::load(name)?;
     if let Some(text) = offset_x {

@@ -8,11 +8,9 @@ use framewright::cache::{Cache, cached_simulation};
 use framewright::cell::Cell;
 use framewright::diff::{Version, diff};
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, cell_facts, model_facts, reason};
-use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::report::simulate::SimReport;
-use framewright::sim::SimOptions;
+use framewright::sim::{SimOptions, prepare};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -27,6 +25,8 @@ pub struct DiffArgs {
     /// Print JSON instead of one line per change.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub panels: super::check::PanelsArg,
     #[command(flatten)]
     pub cache: CacheArgs,
 }
@@ -54,11 +54,9 @@ pub fn plan_and_report(
         let report = SimReport::new(&sim, options.dt);
         return Ok((sim.plan, Some(report)));
     }
-    let mut facts = model_facts(model, &ContactOptions::default());
-    facts.extend(cell_facts(cell));
-    framewright::frame::placement::add_placement_facts(&mut facts, cell, &RuleEngine::Compiled)?;
-    let reasoned = reason(&facts, &RuleEngine::Compiled, false)?;
-    Ok((Plan::from_reasoned(model, &reasoned), None))
+    // The plan a simulation of it would have: one wall per panel the cell builds.
+    let prepared = prepare(model, &file_name(path), cell, &options.engine)?;
+    Ok((prepared.plan, None))
 }
 
 pub fn file_name(path: &Path) -> String {
@@ -69,7 +67,8 @@ pub fn file_name(path: &Path) -> String {
 }
 
 pub fn run(args: DiffArgs) -> CmdResult {
-    let cell = Cell::load(&args.cell)?;
+    let mut cell = Cell::load(&args.cell)?;
+    cell.panel_mode = args.panels.panels;
     let cache = args.cache.open();
     let old = Model::open(&args.old)?;
     let new = Model::open(&args.new)?;

@@ -61,6 +61,8 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "M|auto")]
     pub offset_x: Option<String>,
     #[command(flatten)]
+    pub panels: super::check::PanelsArg,
+    #[command(flatten)]
     pub bcf: super::bcf::BcfArgs,
     #[command(flatten)]
     pub cache: CacheArgs,
@@ -72,7 +74,8 @@ pub struct SimulateArgs {
 
 pub fn run(args: SimulateArgs) -> CmdResult {
     let model = Model::open(&args.model)?;
-    let cell = load_cell(&args.cell, args.offset_x.as_deref())?;
+    let mut cell = load_cell(&args.cell, args.offset_x.as_deref())?;
+    cell.panel_mode = args.panels.panels;
     let options = SimOptions {
         walls: args.walls,
         dt: args.step_ms / 1000.0,

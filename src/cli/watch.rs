@@ -49,6 +49,8 @@ pub struct WatchArgs {
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
     #[command(flatten)]
+    pub panels: super::check::PanelsArg,
+    #[command(flatten)]
     pub cache: CacheArgs,
 }
 
@@ -99,7 +101,8 @@ struct Watch {
 }
 
 pub fn run(args: WatchArgs) -> CmdResult {
-    let cell = Cell::load(&args.cell)?;
+    let mut cell = Cell::load(&args.cell)?;
+    cell.panel_mode = args.panels.panels;
     let options = simulate_defaults();
     let rules = if args.rules.is_empty() {
         None

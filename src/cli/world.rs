@@ -5,7 +5,10 @@
 use super::write_atomically;
 use super::{CmdResult, Failure, print_stdout};
 use framewright::cell::Cell;
-use framewright::world::{Scene, json, wbt};
+use framewright::frame::RuleEngine;
+use framewright::ifc::Model;
+use framewright::sim::prepare;
+use framewright::world::{json, wbt};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -28,14 +31,20 @@ pub struct WorldArgs {
     pub cell: String,
     #[arg(long, value_enum)]
     pub format: WorldFormat,
+    #[command(flatten)]
+    pub panels: super::check::PanelsArg,
     /// Output file (`-` for stdout).
     #[arg(short = 'o', long = "output", value_name = "PATH")]
     pub output: PathBuf,
 }
 
 pub fn run(args: WorldArgs) -> CmdResult {
-    let cell = Cell::load(&args.cell)?;
-    let scene = Scene::from_model_file(&args.model, &cell)?;
+    let mut cell = Cell::load(&args.cell)?;
+    cell.panel_mode = args.panels.panels;
+    let model = Model::open(&args.model)?;
+    let name = super::diff::file_name(&args.model);
+    // The scene of the panels the cell builds.
+    let scene = prepare(&model, &name, &cell, &RuleEngine::Compiled)?.scene;
     let bytes = match args.format {
         WorldFormat::Json => json::to_json(&scene).into_bytes(),
         WorldFormat::Wbt => wbt::to_wbt(&scene).into_bytes(),

@@ -7,6 +7,7 @@ pub mod containers;
 pub mod facts;
 pub mod limits;
 pub mod panel_why;
+pub mod panelize;
 pub mod panels;
 pub mod partition;
 pub mod placement;

@@ -2,6 +2,7 @@
 //! members with roles, assembly order, precedence, nailing and framing targets.
 
 use super::Reasoned;
+use super::panelize::PanelOf;
 use super::panels::{self, WallPanels};
 use crate::cell::PanelLimits;
 use crate::geom::Point3;
@@ -47,6 +48,26 @@ pub struct Wall {
     pub framing_targets: Vec<(String, Isometry3<f64>)>,
     /// The wall split into the panels the cell builds (one when it fits).
     pub panels: WallPanels,
+    /// In a plan of a model cut into panels (`frame::panelize`): the whole wall and the
+    /// panel this wall is. A wall that fits keeps its whole wall's id; a panel of a split
+    /// wall is named by its panel id.
+    pub panel: Option<PanelOf>,
+}
+
+impl Wall {
+    /// The id of the whole wall this wall is or is a panel of.
+    pub fn whole_id(&self) -> &str {
+        self.panel.as_ref().map_or(&self.id, |p| &p.wall_id)
+    }
+
+    /// The id of the panel the cell builds: `W1-P2`, or `W1-P1` for a wall that fits.
+    pub fn panel_id(&self) -> String {
+        match (&self.panel, self.panels.panels.first()) {
+            (Some(p), _) => p.panel_id.clone(),
+            (None, Some(p)) if self.panels.panels.len() == 1 => p.id.clone(),
+            _ => format!("{}-P1", self.id),
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -249,6 +270,7 @@ impl Plan {
                             .map(|(p, pose)| (p.to_string(), pose))
                             .collect(),
                         panels: WallPanels::default(),
+                        panel: None,
                     }
                 })
                 .collect();
@@ -276,19 +298,7 @@ impl Plan {
                 format!("{subject}: {}", sym(&t[1]))
             })
             .collect();
-        for wall in &walls {
-            let split = &wall.panels;
-            warnings.extend(split.notes.iter().map(|n| format!("{}: {n}", wall.id)));
-            for panel in &split.panels {
-                if !panel.exceeds.is_empty() {
-                    warnings.push(format!(
-                        "{}: the panel exceeds the cell's panel limits: {}",
-                        panel.id,
-                        panel.exceeds.join(", ")
-                    ));
-                }
-            }
-        }
+        warnings.extend(panel_warnings(&walls));
         if walls.is_empty() {
             warnings.push(no_walls_reason(model, relations));
         }
@@ -301,6 +311,73 @@ impl Plan {
             panel_limits,
         }
     }
+}
+
+impl Plan {
+    /// What the panel split could not do, by wall or panel: limits dropped, breaks not made,
+    /// panels over a limit.
+    pub fn panel_warnings(&self) -> Vec<String> {
+        panel_warnings(&self.walls)
+    }
+
+    /// Names the walls of a plan of a panelized model after the panels of the whole model's
+    /// plan (`panel_of`, by piece): a panel of a split wall becomes `W1-P2` (name "Wall 1,
+    /// panel 2"), a wall that fits takes its whole wall's id and name back; warnings follow.
+    pub fn name_after_panels(&mut self, panel_of: &BTreeMap<String, PanelOf>) {
+        let mut renamed: BTreeMap<String, String> = BTreeMap::new();
+        for wall in &mut self.walls {
+            let Some(of) = panel_of.get(&wall.key) else {
+                continue;
+            };
+            let split = of.index > 0;
+            let (id, name) = if split {
+                (
+                    of.panel_id.clone(),
+                    format!("{}, panel {}", of.wall_name, of.index),
+                )
+            } else {
+                (of.wall_id.clone(), of.wall_name.clone())
+            };
+            renamed.insert(std::mem::replace(&mut wall.id, id), wall.id.clone());
+            wall.name = name;
+            if let Some(panel) = wall.panels.panels.first_mut() {
+                panel.id.clone_from(&of.panel_id);
+            }
+            wall.panel = Some(of.clone());
+        }
+        for id in self.wall_of.values_mut() {
+            if let Some(new) = renamed.get(id.as_str()) {
+                id.clone_from(new);
+            }
+        }
+        for warning in &mut self.warnings {
+            if let Some((subject, rest)) = warning.split_once(": ")
+                && let Some(new) = renamed.get(subject)
+            {
+                *warning = format!("{new}: {rest}");
+            }
+        }
+    }
+}
+
+/// What the panel split of `walls` could not do: limits dropped, breaks not made, panels over
+/// a limit.
+fn panel_warnings(walls: &[Wall]) -> Vec<String> {
+    let mut warnings = vec![];
+    for wall in walls {
+        let split = &wall.panels;
+        warnings.extend(split.notes.iter().map(|n| format!("{}: {n}", wall.id)));
+        for panel in &split.panels {
+            if !panel.exceeds.is_empty() {
+                warnings.push(format!(
+                    "{}: the panel exceeds the cell's panel limits: {}",
+                    panel.id,
+                    panel.exceeds.join(", ")
+                ));
+            }
+        }
+    }
+    warnings
 }
 
 /// Why a model gave no wall frames, in the user's terms.

@@ -43,7 +43,8 @@ pub struct Model {
     pub groups: BTreeMap<u64, Group>,
     /// Sorted; repaired values and skipped products.
     pub warnings: Vec<Warning>,
-    file: StepFile,
+    /// Shared by a model and the models derived from it (`with_pieces`).
+    file: std::sync::Arc<StepFile>,
 }
 
 impl Model {
@@ -111,12 +112,27 @@ impl Model {
             pieces: read.pieces,
             groups: read.groups,
             warnings: read.warnings,
-            file,
+            file: std::sync::Arc::new(file),
         })
     }
 
     pub fn pieces(&self) -> &[Piece] {
         &self.pieces
+    }
+
+    /// The same model (file, groups, warnings) holding `pieces` instead of its own: a model
+    /// derived from this one, such as its walls cut into panels.
+    pub fn with_pieces(&self, pieces: Vec<Piece>) -> Model {
+        Model {
+            path: self.path.clone(),
+            schema: self.schema,
+            schema_identifier: self.schema_identifier.clone(),
+            length_unit: self.length_unit.clone(),
+            pieces,
+            groups: self.groups.clone(),
+            warnings: self.warnings.clone(),
+            file: self.file.clone(),
+        }
     }
 
     /// Each piece's index in `pieces()`, by piece id.

@@ -22,7 +22,11 @@ pub struct SimReport {
     pub schema: &'static str,
     pub model: String,
     pub cell: String,
+    /// One row per wall of the model: a wall split into panels sums its panels (statuses:
+    /// Completed when every panel's is, Failed when every panel's is, else Partial).
     pub walls: Vec<WallRow>,
+    /// One row per panel the cell built, the unit the cell builds (a wall that fits is one).
+    pub panels: Vec<PanelRow>,
     pub elements: Vec<ElementRow>,
     pub nailing_validation: NailingValidation,
     pub contacts: Vec<ContactRow>,
@@ -39,6 +43,16 @@ pub struct WallRow {
 }
 
 #[derive(Debug, Serialize)]
+pub struct PanelRow {
+    pub panel_id: String,
+    pub wall_id: String,
+    pub name: String,
+    pub material_feeding: String,
+    pub framing: Stage,
+    pub nailing: Stage,
+}
+
+#[derive(Debug, Clone, Serialize)]
 pub struct Stage {
     pub status: String,
     pub time_s: f64,
@@ -50,6 +64,8 @@ pub struct Stage {
 pub struct ElementRow {
     pub id: String,
     pub wall_id: String,
+    /// The panel it is built in (`W1-P2`; `W1-P1` when the wall is one panel).
+    pub panel_id: String,
     pub role: String,
     pub framing: ElementStage,
     pub nailing: ElementStage,
@@ -133,6 +149,75 @@ pub struct SimFigures {
     pub cache: Option<crate::cache::CacheCounts>,
 }
 
+/// One row per whole wall from its panels' rows (in order; a wall's panels are adjacent or
+/// not, the first decides the wall's place); `name_of(i)` names the wall of panel row i.
+fn whole_walls(panels: &[PanelRow], name_of: impl Fn(usize) -> String) -> Vec<WallRow> {
+    let mut order: Vec<&str> = vec![];
+    let mut rows: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+    for (i, p) in panels.iter().enumerate() {
+        let at = rows.entry(p.wall_id.as_str()).or_default();
+        if at.is_empty() {
+            order.push(&p.wall_id);
+        }
+        at.push(i);
+    }
+    order
+        .into_iter()
+        .map(|wall| {
+            let of = &rows[wall];
+            let each = |f: &dyn Fn(&PanelRow) -> &Stage| -> Stage {
+                let stages: Vec<&Stage> = of.iter().map(|&i| f(&panels[i])).collect();
+                combined(&stages)
+            };
+            let feeding: Vec<&str> = of
+                .iter()
+                .map(|&i| panels[i].material_feeding.as_str())
+                .collect();
+            WallRow {
+                wall_id: wall.to_string(),
+                name: name_of(of[0]),
+                material_feeding: if feeding.iter().all(|f| *f == feeding[0]) {
+                    feeding[0].to_string()
+                } else {
+                    "Failed".to_string()
+                },
+                framing: each(&|p| &p.framing),
+                nailing: each(&|p| &p.nailing),
+            }
+        })
+        .collect()
+}
+
+/// Panels' stages as the wall's: Completed when every one is, Failed when every one is, else
+/// Partial; times summed (the cell builds the panels one after another); components at fault
+/// in order of first mention.
+fn combined(stages: &[&Stage]) -> Stage {
+    if let [one] = stages {
+        return (*one).clone();
+    }
+    let all = |s: &str| stages.iter().all(|x| x.status == s);
+    let status = if all("Completed") {
+        "Completed"
+    } else if all("Failed") {
+        "Failed"
+    } else {
+        "Partial"
+    };
+    let mut failed: Vec<&str> = vec![];
+    for s in stages {
+        for c in s.failed_component.split(", ").filter(|c| !c.is_empty()) {
+            if !failed.contains(&c) {
+                failed.push(c);
+            }
+        }
+    }
+    Stage {
+        status: status.to_string(),
+        time_s: r6(stages.iter().map(|s| s.time_s).sum()),
+        failed_component: failed.join(", "),
+    }
+}
+
 fn sym(v: &Value) -> String {
     v.as_symbol().unwrap_or_default().to_string()
 }
@@ -178,14 +263,21 @@ impl SimReport {
             .collect();
         let feeding = status("wall_feeding");
 
-        // Records and relations name a wall by its key piece; the report by the plan's id.
-        let walls_by_key: BTreeMap<&str, (&str, &str)> = sim
-            .plan
-            .walls
-            .iter()
-            .map(|w| (w.key.as_str(), (w.id.as_str(), w.name.as_str())))
-            .collect();
-        let wall_id = |key: &str| walls_by_key.get(key).map_or(key, |w| w.0).to_string();
+        // Records and relations name a wall by its key piece; the report by the whole wall's
+        // id and the panel's.
+        let walls_by_key: BTreeMap<&str, &crate::frame::plan::Wall> =
+            sim.plan.walls.iter().map(|w| (w.key.as_str(), w)).collect();
+        let wall_id = |key: &str| {
+            walls_by_key
+                .get(key)
+                .map_or(key, |w| w.whole_id())
+                .to_string()
+        };
+        let panel_id = |key: &str| {
+            walls_by_key
+                .get(key)
+                .map_or_else(|| key.to_string(), |w| w.panel_id())
+        };
         let stage = |wall: &str, which: &str| {
             let key = (wall.to_string(), which.to_string());
             let (status, time) = stages.get(&key).cloned().unwrap_or_default();
@@ -199,20 +291,29 @@ impl SimReport {
                 failed_component: failed,
             }
         };
-        let walls = sim
+        let panels: Vec<PanelRow> = sim
             .records
             .iter()
-            .map(|rec| WallRow {
+            .map(|rec| PanelRow {
+                panel_id: panel_id(&rec.wall),
                 wall_id: wall_id(&rec.wall),
                 name: walls_by_key
                     .get(rec.wall.as_str())
-                    .map_or("", |w| w.1)
+                    .map_or("", |w| w.name.as_str())
                     .to_string(),
                 material_feeding: feeding.get(&rec.wall).cloned().unwrap_or_default(),
                 framing: stage(&rec.wall, "framing"),
                 nailing: stage(&rec.wall, "nailing"),
             })
             .collect();
+        let whole_name = |key: &str| {
+            walls_by_key.get(key).map_or_else(String::new, |w| {
+                w.panel
+                    .as_ref()
+                    .map_or_else(|| w.name.clone(), |p| p.wall_name.clone())
+            })
+        };
+        let walls = whole_walls(&panels, |i| whole_name(&sim.records[i].wall));
 
         let mut elements = Vec::new();
         for rec in &sim.records {
@@ -228,6 +329,7 @@ impl SimReport {
                 elements.push(ElementRow {
                     id: id.clone(),
                     wall_id: wall_id(&rec.wall),
+                    panel_id: panel_id(&rec.wall),
                     role: sim.plan.roles.get(id).cloned().unwrap_or_default(),
                     framing: stage("framing", &framing),
                     nailing: stage("nailing", &nailing),
@@ -302,6 +404,7 @@ impl SimReport {
             model: sim.scene.model.clone(),
             cell: sim.scene.cell.clone(),
             walls,
+            panels,
             elements,
             nailing_validation,
             contacts,

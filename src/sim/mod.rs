@@ -9,18 +9,19 @@ mod executor;
 mod motion;
 mod physics;
 pub mod planner;
+mod prepare;
 mod reach;
 pub mod record;
 
 pub use executor::NailPlan;
 pub use motion::{JointMove, LinearMove, Profile};
+pub use prepare::{Prepared, prepare, prepare_facts, whole_facts};
 pub use record::WallRecord;
 
 use crate::cell::Cell;
 use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, cell_facts, model_facts, reason};
-use crate::geom::ContactOptions;
+use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, reason};
 use crate::ifc::Model;
 use crate::world::{Scene, SceneWall, WorldError};
 use std::collections::BTreeSet;
@@ -126,6 +127,7 @@ pub fn max_sim_seconds_per_wall() -> Result<f64, SimError> {
 /// A finished simulation.
 pub struct Simulation {
     pub scene: Scene,
+    /// One wall per panel the cell builds (a wall that fits is one).
     pub plan: Plan,
     /// One record per simulated wall, in wall order.
     pub records: Vec<WallRecord>,
@@ -133,6 +135,9 @@ pub struct Simulation {
     pub facts: Facts,
     /// Model, cell and simulation facts reasoned with the rule base (verdicts included).
     pub reasoned: Reasoned,
+    /// The model cut into panels, when a wall was split: the pieces the scene, the plan and
+    /// the records name (cut plates, added studs).
+    pub panelized: Option<Model>,
 }
 
 /// Simulates the walls of a model in a cell.
@@ -148,22 +153,28 @@ pub fn simulate_with_progress(
     options: &SimOptions,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<Simulation, SimError> {
-    let mut facts = model_facts(model, &ContactOptions::default());
-    facts.extend(cell_facts(cell));
-    let (scene, plan, records) = run_walls(model, model_name, cell, options, &mut facts, progress)?;
-    Simulation::from_records(facts, scene, plan, records, &options.engine)
+    check_options(options)?;
+    let prepared = prepare(model, model_name, cell, &options.engine)?;
+    let selected = select_walls(&prepared.plan, &options.walls)?;
+    let records = run_prepared(&prepared, cell, options, &selected, progress)?;
+    Simulation::from_prepared(prepared, records, &options.engine)
 }
 
 impl Simulation {
-    /// The simulation of `records` (in wall order): their facts added to the model's and the
-    /// cell's `facts` and reasoned over with the rule base.
-    pub fn from_records(
-        mut facts: Facts,
-        scene: Scene,
-        plan: Plan,
+    /// The simulation of `records` (in wall order): their facts added to the prepared facts
+    /// and reasoned over with the rule base.
+    pub fn from_prepared(
+        prepared: Prepared,
         records: Vec<WallRecord>,
         engine: &RuleEngine,
     ) -> Result<Simulation, SimError> {
+        let Prepared {
+            mut facts,
+            scene,
+            plan,
+            panelized,
+            ..
+        } = prepared;
         let sim_facts = records_facts(&records);
         facts.extend(sim_facts.clone());
         let reasoned = reason(&facts, engine, false)?;
@@ -173,7 +184,13 @@ impl Simulation {
             records,
             facts: sim_facts,
             reasoned,
+            panelized,
         })
+    }
+
+    /// The model the simulation's pieces come from: the panelized one, else `model`.
+    pub fn model<'a>(&'a self, model: &'a Model) -> &'a Model {
+        self.panelized.as_ref().unwrap_or(model)
     }
 }
 
@@ -196,8 +213,8 @@ pub fn simulate_wall_facts(
     cell: &Cell,
     options: &SimOptions,
 ) -> Result<Facts, SimError> {
-    let mut facts = model_facts(model, &ContactOptions::default());
-    facts.extend(cell_facts(cell));
+    check_options(options)?;
+    let facts = whole_facts(model, cell);
     // A wall named otherwise (by name, or by no piece) keeps the whole model.
     let mut containers = BTreeSet::new();
     let mut each_in_one = !options.walls.is_empty();
@@ -206,31 +223,32 @@ pub fn simulate_wall_facts(
         each_in_one &= !of_wall.is_empty();
         containers.extend(of_wall);
     }
-    if each_in_one {
-        facts = restrict_to_containers(&facts, &containers);
-    }
-    let (_, _, records) = run_walls(model, "model", cell, options, &mut facts, &|_, _, _| {})?;
+    let restrict = |facts: Facts| {
+        if each_in_one {
+            restrict_to_containers(&facts, &containers)
+        } else {
+            facts
+        }
+    };
+    let facts = restrict(facts);
+    let prepared = prepare_facts(model, "model", cell, &options.engine, facts, &restrict)?;
+    let selected = select_walls(&prepared.plan, &options.walls)?;
+    let records = run_prepared(&prepared, cell, options, &selected, &|_, _, _| {})?;
     Ok(records_facts(&records))
 }
 
-/// Places and reasons `facts` (a model's and a cell's), then runs the selected walls in
-/// parallel: the scene, the plan and one record per wall, in wall order.
-fn run_walls(
-    model: &Model,
-    model_name: &str,
+/// Runs the walls `selected` (keys, in plan order) of a prepared run in parallel: one record
+/// per wall, in their order.
+pub fn run_prepared(
+    prepared: &Prepared,
     cell: &Cell,
     options: &SimOptions,
-    facts: &mut Facts,
+    selected: &[String],
     progress: &(dyn Fn(&str, usize, usize) + Sync),
-) -> Result<(Scene, Plan, Vec<WallRecord>), SimError> {
+) -> Result<Vec<WallRecord>, SimError> {
     check_options(options)?;
     let limit = max_sim_seconds_per_wall()?;
-    crate::frame::placement::add_placement_facts(facts, cell, &options.engine)?;
-    let planned = reason(facts, &options.engine, false)?;
-    let scene = Scene::build(model_name, model, cell, &planned)?;
-    let plan = Plan::from_reasoned(model, &planned);
-    let selected = select_walls(&plan, &options.walls)?;
-
+    let (scene, plan) = (&prepared.scene, &prepared.plan);
     // The rules name a wall by its key piece; the scene does too.
     let walls: Vec<&SceneWall> = selected
         .iter()
@@ -254,11 +272,10 @@ fn run_walls(
             reached,
         }))
     };
-    let records = largest_first(&walls, |w| w.pieces.len(), run_wall)
+    largest_first(&walls, |w| w.pieces.len(), run_wall)
         .into_iter()
         .flatten()
-        .collect::<Result<Vec<WallRecord>, SimError>>()?;
-    Ok((scene, plan, records))
+        .collect()
 }
 
 /// `run` on every item on all threads, the costliest first (each thread takes the next item
@@ -330,19 +347,38 @@ pub fn select_walls(plan: &Plan, wanted: &[String]) -> Result<Vec<String>, SimEr
     }
     let mut ids = Vec::new();
     for name in wanted {
-        let wall = with_pieces
+        // A wall by its id, name or key piece; else every panel of a whole wall so named.
+        let exact: Vec<&&crate::frame::plan::Wall> = with_pieces
             .iter()
-            .find(|w| &w.id == name || &w.name == name || &w.key == name)
-            .ok_or_else(|| SimError::UnknownWall {
+            .filter(|w| &w.id == name || &w.name == name || &w.key == name)
+            .take(1)
+            .collect();
+        let found = if exact.is_empty() {
+            with_pieces
+                .iter()
+                .filter(|w| {
+                    w.panel.as_ref().is_some_and(|p| {
+                        &p.wall_key == name || &p.wall_id == name || &p.wall_name == name
+                    })
+                })
+                .collect()
+        } else {
+            exact
+        };
+        if found.is_empty() {
+            return Err(SimError::UnknownWall {
                 name: name.clone(),
                 known: with_pieces
                     .iter()
                     .map(|w| format!("{} ({})", w.name, w.id))
                     .collect::<Vec<_>>()
                     .join(", "),
-            })?;
-        if !ids.contains(&wall.key) {
-            ids.push(wall.key.clone());
+            });
+        }
+        for wall in found {
+            if !ids.contains(&wall.key) {
+                ids.push(wall.key.clone());
+            }
         }
     }
     Ok(plan

@@ -134,6 +134,7 @@ inputs! {
     "piece_material" => r_piece_material(0: Sym, 1: Sym, 2: F64);
     "contact" => r_contact(0: Sym, 1: Sym, 2: Sym, 3: Sym, 4: Sym, 5: F64, 6: Vec3, 7: Vec3);
     "crossing" => r_crossing(0: Sym, 1: Sym, 2: F64);
+    "panel_piece" => r_panel_piece(0: Sym, 1: Sym, 2: Sym);
     "cell_value" => r_cell_value(0: Sym, 1: F64);
     "cell_choice" => r_cell_choice(0: Sym, 1: Sym);
     "placement_candidate" => r_placement_candidate(0: Sym, 1: F64);

@@ -1,0 +1,43 @@
+//! Small edits of the synthetic models' IFC text: the tests move a stud and see what follows.
+
+use std::collections::BTreeMap;
+
+/// `text` with the IfcCartesianPoint `point` (`#id`) moved by `du` along x.
+pub fn move_point(text: &str, point: &str, du: f64) -> String {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(&format!("{point}=")))
+        .unwrap();
+    let body = &line[line.find("((").unwrap() + 2..line.find("))").unwrap()];
+    let xyz: Vec<f64> = body.split(',').map(|c| c.trim().parse().unwrap()).collect();
+    let new = format!(
+        "{point}=IFCCARTESIANPOINT(({:?},{:?},{:?}));",
+        xyz[0] + du,
+        xyz[1],
+        xyz[2]
+    );
+    text.replacen(line, &new, 1)
+}
+
+/// The placement points of the model's studs (IfcMember .STUD.), in file order.
+pub fn stud_points(text: &str) -> Vec<String> {
+    let lines: BTreeMap<&str, &str> = text
+        .lines()
+        .filter_map(|l| l.split_once('='))
+        .filter(|(id, _)| id.starts_with('#'))
+        .collect();
+    let inside = |id: &str| {
+        let body = lines[id.trim()];
+        body[body.find('(').unwrap() + 1..body.rfind(')').unwrap()].to_string()
+    };
+    text.lines()
+        .filter(|l| l.contains("IFCMEMBER(") && l.contains(".STUD."))
+        .map(|l| {
+            let body = l.split_once('=').unwrap().1;
+            let placement = body.split(',').nth(5).unwrap().trim().to_string();
+            let local = inside(&placement);
+            let axis = local.split_once(',').unwrap().1.to_string();
+            inside(&axis).split(',').next().unwrap().trim().to_string()
+        })
+        .collect()
+}
