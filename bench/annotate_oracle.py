@@ -11,7 +11,11 @@ PLAN.json is `framewright plan INPUT.ifc --json`. Checks, each printed; exit 1 o
   1-based position in its wall's assembly order, the pieces it must follow;
 - one IfcTask per piece in a wall, assigned to its element; IfcRelSequence (FINISH_START)
   between the tasks of exactly the precedence pairs;
-- one IfcMechanicalFastener (NAIL) per nailing target, connected to its plate and member.
+- one IfcMechanicalFastener (NAIL) per nailing target, connected to its plate and member;
+- one IfcElementAssembly (ObjectType PANEL, Tag the panel id) per panel of a split wall,
+  holding (aggregated, or assigned when the model already aggregates them) exactly the
+  products the plan lists whole in that panel and one new IfcMember per plate segment and
+  added end stud, whose body (meshed by IfcOpenShell) spans the segment's u range along the wall.
 """
 import argparse
 import collections
@@ -19,7 +23,9 @@ import json
 import sys
 
 import ifcopenshell
+import ifcopenshell.geom
 import ifcopenshell.util.element
+import numpy
 import ifcopenshell.validate
 
 failures = []
@@ -128,10 +134,59 @@ def main():
                                if piece_gid[t["plate"]] != piece_gid[t["member"]])
     check(joined == want, f"{sum(joined.values())} nails connect their plate and member")
 
+    check_panels(plan, out, piece_gid)
+
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)
     print("all checks passed")
+
+
+def check_panels(plan, out, piece_gid):
+    split = [w for w in plan["walls"] if len(w.get("panels", [])) > 1]
+    assemblies = {a.Tag: a for a in out.by_type("IfcElementAssembly") if a.ObjectType == "PANEL"}
+    want = {p["panel_id"] for w in split for p in w["panels"]}
+    check(set(assemblies) == want, f"{len(assemblies)} panel assemblies for {len(want)} panels of split walls")
+    if not split:
+        return
+    panels_of = collections.defaultdict(set)
+    for w in split:
+        for p in w["panels"]:
+            for m in p["member_ids"]:
+                panels_of[piece_gid[m]].add(p["panel_id"])
+    assigned = collections.defaultdict(set)
+    for rel in out.by_type("IfcRelAssignsToProduct"):
+        assigned[rel.RelatingProduct.id()] |= set(rel.RelatedObjects)
+    settings = ifcopenshell.geom.settings()
+    settings.set("use-world-coords", True)
+    originals = set(piece_gid.values())
+    for w in split:
+        frame = numpy.array(w["frame_matrix"])
+        origin, along = frame[:3, 3], frame[:3, 0]
+        for p in w["panels"]:
+            a = assemblies.get(p["panel_id"])
+            if a is None:
+                continue
+            held = set(assigned[a.id()])
+            for rel in a.IsDecomposedBy:
+                held |= set(rel.RelatedObjects)
+            whole = {piece_gid[m] for m in p["member_ids"] if panels_of[piece_gid[m]] == {p["panel_id"]}}
+            derived = {c["id"]: c for c in p["cut_pieces"] + p["added_pieces"]}
+            old = {o.GlobalId for o in held if o.GlobalId in originals}
+            new = {o.Tag: o for o in held if o.GlobalId not in originals}
+            check(old == whole and set(new) == set(derived) and all(o.is_a("IfcMember") for o in new.values()),
+                  f"{p['panel_id']} holds its {len(whole)} products and {len(derived)} new members "
+                  f"(found {len(old)} and {len(new)})")
+            bad = []
+            for tag, piece in derived.items():
+                if tag not in new:
+                    continue
+                shape = ifcopenshell.geom.create_shape(settings, new[tag])
+                verts = numpy.array(shape.geometry.verts).reshape(-1, 3)
+                u = (verts - origin) @ along
+                if abs(u.min() - piece["u_start"]) > 1e-3 or abs(u.max() - piece["u_end"]) > 1e-3:
+                    bad.append(f"{tag}: u {u.min():.4f}..{u.max():.4f}, planned {piece['u_start']:.4f}..{piece['u_end']:.4f}")
+            check(not bad, f"{p['panel_id']}: the new members' bodies span their planned u ranges {bad[:3]}")
 
 
 if __name__ == "__main__":

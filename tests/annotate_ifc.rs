@@ -304,6 +304,26 @@ fn ifcopenshell_validates_and_finds_the_plan() {
     ] {
         models.extend(common::shared_path(name));
     }
+    // Walls longer than the cell carries: split into panels, written as assemblies (one model
+    // whose members an IfcWall aggregates, one whose members are loose).
+    for (name, grouping) in [("long20.ifc", "wall"), ("long9.ifc", "none")] {
+        let path = dir.path().join(name);
+        let length = if grouping == "wall" { "20" } else { "9" };
+        let synth = framewright(&[
+            "synth",
+            "wall",
+            "--length",
+            length,
+            "--grouping",
+            grouping,
+            "--window",
+            "2.0,1.2,1.2,0.9",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(synth.status.success());
+        models.push(path);
+    }
     for model in models {
         let out = dir.path().join("out.ifc");
         annotate(&model, &out, &[]);

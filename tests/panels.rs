@@ -707,7 +707,7 @@ fn why_explains_panels_segments_added_studs_and_breaks_not_made() {
 }
 
 #[test]
-fn the_report_draws_the_breaks_and_lists_the_panels() {
+fn the_report_shows_each_panel_on_its_own_with_the_walls_panels() {
     let dir = tempfile::tempdir().unwrap();
     let ifc = dir.path().join("w9.ifc");
     let m = ifc.to_str().unwrap();
@@ -733,18 +733,45 @@ fn the_report_draws_the_breaks_and_lists_the_panels() {
         out.to_str().unwrap(),
     ]);
     let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    // Each panel is built, drawn and reported on its own, with the wall's panels listed.
     assert_eq!(
-        page.matches("class=\"panel-break\"").count(),
-        panels.len() - 1
+        page.matches("<table class=\"panels\">").count(),
+        panels.len(),
+        "one panel table per panel section"
     );
-    assert!(page.contains("<table class=\"panels\">"), "no panel table");
     for p in panels {
         let id = p["panel_id"].as_str().unwrap();
         assert!(page.contains(&format!("<td>{id}</td>")), "no row for {id}");
         assert!(
-            page.contains(&format!("{id} · {:.2} m", f(&p["length"]))),
-            "no label for {id}"
+            page.contains(&format!("({id})</h2>")),
+            "no section for {id}"
         );
+        assert!(
+            page.contains(&format!("<tr class=\"this\"><td>{id}</td>")),
+            "{id}'s section does not mark its own row"
+        );
+    }
+    // Each section draws exactly its panel's pieces: the plan's members, segments and added
+    // studs of that panel.
+    let sections: Vec<&str> = page.split("<section class=\"wall\"").skip(1).collect();
+    assert_eq!(sections.len(), panels.len());
+    for (p, section) in panels.iter().zip(&sections) {
+        let mut expected: Vec<&str> = strs(&p["member_ids"]);
+        for kind in ["cut_pieces", "added_pieces"] {
+            for piece in p[kind].as_array().unwrap() {
+                expected.push(piece["id"].as_str().unwrap());
+            }
+        }
+        expected.sort_unstable();
+        let mut drawn: Vec<&str> = section
+            .split("data-id=\"")
+            .skip(1)
+            .map(|rest| &rest[..rest.find('"').unwrap()])
+            .collect();
+        // A piece appears in each drawing (elevation, cell view, timeline).
+        drawn.sort_unstable();
+        drawn.dedup();
+        assert_eq!(drawn, expected, "{}", p["panel_id"]);
     }
     // A wall that fits has neither.
     let one = dir.path().join("w6.ifc");
@@ -765,5 +792,5 @@ fn the_report_draws_the_breaks_and_lists_the_panels() {
         out.to_str().unwrap(),
     ]);
     let page = std::fs::read_to_string(out.join("index.html")).unwrap();
-    assert!(!page.contains("panel-break") && !page.contains("class=\"panels\""));
+    assert!(!page.contains("class=\"panels\""));
 }

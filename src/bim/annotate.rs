@@ -8,6 +8,9 @@
 //!   wall a summary `IfcTask` with one nested `IfcTask` per piece in assembly order,
 //!   `IfcRelSequence` (FINISH_START) for every precedence pair, `IfcRelAssignsToProcess`
 //!   tying each piece's task to its element;
+//! - each panel of a split wall as an `IfcElementAssembly` of its members, plate segments and
+//!   added end studs as new `IfcMember`s (`bim::panels`); every piece of a split wall names
+//!   its panel (`Panel`);
 //! - the nails as `IfcMechanicalFastener` (NAIL) at the nailing targets, with a body,
 //!   contained where the plate is and connected to the plate and the member they join
 //!   (`IfcRelConnectsWithRealizingElements`).
@@ -77,6 +80,8 @@ pub struct Annotated {
     pub tasks: usize,
     pub sequences: usize,
     pub fasteners: usize,
+    /// Panels written as `IfcElementAssembly`, and the members added to them.
+    pub panels: super::panels::PanelsWritten,
     pub first_new_id: u64,
 }
 
@@ -88,17 +93,17 @@ fn short(text: &str) -> &str {
 }
 
 /// A label attribute (names): at most 255 characters.
-fn label(text: &str) -> String {
+pub(super) fn label(text: &str) -> String {
     string(short(text))
 }
 
 /// `IFCLABEL('…')` and friends.
-fn typed(kind: &str, text: &str) -> String {
+pub(super) fn typed(kind: &str, text: &str) -> String {
     let text = if kind == "IFCTEXT" { text } else { short(text) };
     format!("{kind}({})", string(text))
 }
 
-fn guid_for(kind: &str, key: &str) -> String {
+pub(super) fn guid_for(kind: &str, key: &str) -> String {
     string(&guid::global_id(
         GUID_SEED,
         &format!("framewright/annotate/{kind}/{key}"),
@@ -160,7 +165,7 @@ fn products(model: &Model) -> Vec<(u64, Vec<&Piece>)> {
 }
 
 /// One property: a single value for a one-piece product, a list (one value per piece) otherwise.
-fn property(w: &mut Appender, name: &str, values: &[String]) -> Ref {
+pub(super) fn property(w: &mut Appender, name: &str, values: &[String]) -> Ref {
     if let [value] = values {
         w.add(
             "IFCPROPERTYSINGLEVALUE",
@@ -177,6 +182,8 @@ fn property(w: &mut Appender, name: &str, values: &[String]) -> Ref {
 /// Everything the writer needs to know about the plan, by piece id.
 struct PlanIndex<'a> {
     wall: BTreeMap<&'a str, &'a Wall>,
+    /// The panel of each piece of a split wall; a cut plate lists its segments' panels.
+    panel: BTreeMap<&'a str, String>,
     position: BTreeMap<&'a str, usize>,
     follows: BTreeMap<&'a str, Vec<&'a str>>,
 }
@@ -185,9 +192,24 @@ impl<'a> PlanIndex<'a> {
     fn new(plan: &'a Plan) -> PlanIndex<'a> {
         let mut index = PlanIndex {
             wall: BTreeMap::new(),
+            panel: BTreeMap::new(),
             position: BTreeMap::new(),
             follows: BTreeMap::new(),
         };
+        for wall in plan.walls.iter().filter(|w| w.panels.panels.len() > 1) {
+            for panel in &wall.panels.panels {
+                for m in &panel.member_ids {
+                    index.panel.insert(m, panel.id.clone());
+                }
+                for cut in &panel.cut_pieces {
+                    let entry = index
+                        .panel
+                        .entry(&cut.of)
+                        .or_insert_with(|| "cut into".into());
+                    entry.push_str(&format!(" {} ({})", cut.id, panel.id));
+                }
+            }
+        }
         for wall in &plan.walls {
             for (i, p) in wall.assembly_order.iter().enumerate() {
                 index.wall.insert(p, wall);
@@ -399,6 +421,14 @@ pub fn annotate(
     }
 
     let fasteners = write_nails(&mut w, file, plan, &pieces, nail, unit);
+    let panels = super::panels::write_panels(
+        &mut w,
+        plan,
+        &pieces,
+        body_context(file),
+        unit,
+        options.verdicts.as_ref(),
+    );
 
     // The header names the tool that wrote this file; every other byte stays.
     let header = model.header();
@@ -430,6 +460,7 @@ pub fn annotate(
         tasks,
         sequences,
         fasteners,
+        panels,
         first_new_id: max_id + 1,
     })
 }
@@ -470,6 +501,21 @@ fn element_properties(
         "Wall",
         &per_piece(&|p| typed("IFCLABEL", wall_of(p).map_or("", |w| w.name.as_str()))),
     ));
+    if parts
+        .iter()
+        .any(|p| index.panel.contains_key(p.id.as_str()))
+    {
+        props.push(property(
+            w,
+            "Panel",
+            &per_piece(&|p| {
+                typed(
+                    "IFCLABEL",
+                    index.panel.get(p.id.as_str()).map_or("", String::as_str),
+                )
+            }),
+        ));
+    }
     props.push(property(
         w,
         "AssemblyPosition",

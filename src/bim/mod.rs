@@ -4,12 +4,15 @@
 //! - `annotate`: the input IFC with property sets, the assembly sequence as
 //!   processes (IfcWorkSchedule, IfcTask, IfcRelSequence) and the nails as
 //!   IfcMechanicalFastener appended; the input's entities are kept byte for byte.
+//! - `panels`: each panel of a split wall as an IfcElementAssembly of its members (plate
+//!   segments and added end studs as new IfcMembers), written by `annotate`.
 //! - `bcf`: BCF 2.1 / 3.0 topics (one per root cause per wall) from a simulation.
 //! - `step_edit`: the byte-level edit of a STEP file (header record, appended entities).
 
 pub mod annotate;
 pub mod bcf;
 mod error;
+mod panels;
 pub mod step_edit;
 mod verdicts;
 

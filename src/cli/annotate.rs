@@ -45,12 +45,15 @@ pub fn run(args: AnnotateArgs) -> CmdResult {
     let (plan, verdicts) = if args.simulate {
         let options = SimOptions {
             walls: args.walls.clone(),
-            engine,
+            engine: engine.clone(),
             ..SimOptions::default()
         };
         let sim = simulate(&model, &cell, &options)?;
         let verdicts = element_verdicts(&sim);
-        (sim.plan, Some(verdicts))
+        // The model's own walls, each with its panels (the simulation's plan has one wall per
+        // panel, of pieces partly not in the model).
+        let reasoned = reason(&facts, &engine, false)?;
+        (Plan::from_reasoned(&model, &reasoned), Some(verdicts))
     } else {
         let reasoned = reason(&facts, &engine, false)?;
         (Plan::from_reasoned(&model, &reasoned), None)
@@ -67,12 +70,14 @@ pub fn run(args: AnnotateArgs) -> CmdResult {
     write_atomically(&args.output, &annotated.bytes)
         .map_err(|e| Failure::bad_input(format!("cannot write {}: {e}", args.output.display())))?;
     eprintln!(
-        "{}: {} property sets, {} tasks, {} sequences, {} nails (entities from #{})",
+        "{}: {} property sets, {} tasks, {} sequences, {} nails, {} panels with {} added members (entities from #{})",
         args.output.display(),
         annotated.property_sets,
         annotated.tasks,
         annotated.sequences,
         annotated.fasteners,
+        annotated.panels.assemblies,
+        annotated.panels.members,
         annotated.first_new_id
     );
     Ok(ExitCode::SUCCESS)

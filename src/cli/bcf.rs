@@ -64,7 +64,7 @@ impl BcfArgs {
             project_global_id: project,
             date: date.to_string(),
         };
-        let mut topics = topics_of(model, sim, &header);
+        let mut topics = topics_of(sim.model(model), sim, &header);
         // Each topic shows its wall's elevation drawing, rendered once per wall.
         let mut snapshots: BTreeMap<String, Snapshot> = BTreeMap::new();
         for topic in &mut topics {

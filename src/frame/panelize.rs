@@ -96,18 +96,13 @@ pub fn panelize(model: &Model, plan: &Plan) -> Option<Panelized> {
     let mut following: BTreeMap<&str, Vec<Piece>> = BTreeMap::new();
     let by_id: BTreeMap<&str, &Piece> = model.pieces().iter().map(|p| (p.id.as_str(), p)).collect();
     for wall in &split {
-        let origin = wall.frame.translation.vector;
-        let along = wall.frame.rotation * Vector3::x();
-        let mid_u = |b: &OrientedBox| (b.centre.coords - origin).dot(&along);
         for panel in &wall.panels.panels {
             for cut in &panel.cut_pieces {
                 let Some(plate) = by_id.get(cut.of.as_str()) else {
                     continue;
                 };
                 let mut piece = derived(plate, &cut.id);
-                let shift = (cut.u_start + cut.u_end) / 2.0 - mid_u(&plate.obox);
-                piece.obox.centre += along * shift;
-                piece.obox.half[0] = (cut.u_end - cut.u_start) / 2.0;
+                piece.obox = segment_box(&plate.obox, wall, cut.u_start, cut.u_end);
                 replaced.entry(plate.id.as_str()).or_default().push(piece);
             }
             for added in &panel.added_pieces {
@@ -115,8 +110,7 @@ pub fn panelize(model: &Model, plan: &Plan) -> Option<Panelized> {
                     continue;
                 };
                 let mut piece = derived(stud, &added.id);
-                let shift = (added.u_start + added.u_end) / 2.0 - mid_u(&stud.obox);
-                piece.obox.centre += along * shift;
+                piece.obox = moved_box(&stud.obox, wall, added.u_start, added.u_end);
                 following.entry(stud.id.as_str()).or_default().push(piece);
             }
         }
@@ -156,6 +150,24 @@ pub fn panelize(model: &Model, plan: &Plan) -> Option<Panelized> {
         panel_of,
         facts,
     })
+}
+
+/// The box of a level plate cut to `u_start..u_end` of its wall (world frame): the plate's
+/// length axis runs along the wall's u.
+pub fn segment_box(plate: &OrientedBox, wall: &Wall, u_start: f64, u_end: f64) -> OrientedBox {
+    let mut b = moved_box(plate, wall, u_start, u_end);
+    b.half[0] = (u_end - u_start) / 2.0;
+    b
+}
+
+/// A box moved along its wall's u so that its middle lies at the middle of `u_start..u_end`.
+pub fn moved_box(b: &OrientedBox, wall: &Wall, u_start: f64, u_end: f64) -> OrientedBox {
+    let origin = wall.frame.translation.vector;
+    let along = wall.frame.rotation * Vector3::x();
+    let mid = (b.centre.coords - origin).dot(&along);
+    let mut moved = *b;
+    moved.centre += along * ((u_start + u_end) / 2.0 - mid);
+    moved
 }
 
 /// A piece derived from `from` (same product, material, container), named `id`.

@@ -46,7 +46,8 @@ pub struct Wall {
     pub precedence: Vec<(String, String, String)>,
     pub nailing_targets: Vec<NailingTarget>,
     pub framing_targets: Vec<(String, Isometry3<f64>)>,
-    /// The wall split into the panels the cell builds (one when it fits).
+    /// The wall split into the panels the cell builds (one when it fits); a panel of a split
+    /// wall (`panel` set, index > 0) holds its whole wall's split.
     pub panels: WallPanels,
     /// In a plan of a model cut into panels (`frame::panelize`): the whole wall and the
     /// panel this wall is. A wall that fits keeps its whole wall's id; a panel of a split
@@ -321,9 +322,16 @@ impl Plan {
     }
 
     /// Names the walls of a plan of a panelized model after the panels of the whole model's
-    /// plan (`panel_of`, by piece): a panel of a split wall becomes `W1-P2` (name "Wall 1,
-    /// panel 2"), a wall that fits takes its whole wall's id and name back; warnings follow.
-    pub fn name_after_panels(&mut self, panel_of: &BTreeMap<String, PanelOf>) {
+    /// plan `whole`: a panel of a split wall becomes `W1-P2` (name "Wall 1, panel 2") and holds
+    /// its whole wall's split (`panels`, all of them); a wall that fits takes its whole wall's
+    /// id and name back; warnings follow.
+    pub fn name_after_panels(&mut self, whole: &Plan) {
+        let panel_of = super::panelize::panels_by_piece(whole);
+        let splits: BTreeMap<&str, &WallPanels> = whole
+            .walls
+            .iter()
+            .map(|w| (w.key.as_str(), &w.panels))
+            .collect();
         let mut renamed: BTreeMap<String, String> = BTreeMap::new();
         for wall in &mut self.walls {
             let Some(of) = panel_of.get(&wall.key) else {
@@ -340,8 +348,13 @@ impl Plan {
             };
             renamed.insert(std::mem::replace(&mut wall.id, id), wall.id.clone());
             wall.name = name;
-            if let Some(panel) = wall.panels.panels.first_mut() {
-                panel.id.clone_from(&of.panel_id);
+            match splits.get(of.wall_key.as_str()) {
+                Some(split) if of.index > 0 => wall.panels = (*split).clone(),
+                _ => {
+                    if let Some(panel) = wall.panels.panels.first_mut() {
+                        panel.id.clone_from(&of.panel_id);
+                    }
+                }
             }
             wall.panel = Some(of.clone());
         }

@@ -6,7 +6,7 @@
 //!
 //! API (kept small and stable; other exporters reuse it):
 //! - [`root_causes`]`(report, wall_id) -> Vec<RootCause>` for one wall of a [`SimReport`]
-//!   (`wall_id` as in `WallRow::wall_id`; an unknown wall gives an empty list).
+//!   (`wall_id` as the plan names the simulated wall, or a whole wall's id for all its panels; an unknown wall gives an empty list).
 //! - [`RootCause`]: `piece` (element id at fault), `stage` (`framing` | `nailing`),
 //!   `component` (Robot, Gripper, Conveyor, Nailer), `message` (one line, with numbers) and
 //!   `consequences`.
@@ -61,13 +61,13 @@ pub fn root_causes(report: &SimReport, wall_id: &str) -> Vec<RootCause> {
     let elements: Vec<&ElementRow> = report
         .elements
         .iter()
-        .filter(|e| e.wall_id == wall_id)
+        .filter(|e| e.wall_id == wall_id || e.panel_id == wall_id)
         .collect();
     let nails: Vec<&NailRow> = report
         .nailing_validation
         .targets
         .iter()
-        .filter(|n| n.wall_id == wall_id)
+        .filter(|n| n.wall_id == wall_id || n.panel_id == wall_id)
         .collect();
     let order: BTreeMap<&str, usize> = elements
         .iter()

@@ -90,11 +90,14 @@ pub fn report_files_within(
         }
         Ok(())
     };
+    // One view per wall the cell built: a wall that fits, or a panel of a split wall.
+    let model = input.sim.model(input.model);
     let walls: Vec<WallView> = input
-        .report
-        .walls
+        .sim
+        .records
         .iter()
-        .filter_map(|w| WallView::new(input.sim, input.report, Some(input.model), &w.wall_id))
+        .filter_map(|r| input.sim.plan.walls.iter().find(|w| w.key == r.wall))
+        .filter_map(|w| WallView::new(input.sim, input.report, Some(model), &w.id))
         .collect();
     let split = walls.len() > WALLS_PER_PAGE;
     let mut files = Vec::new();
@@ -215,10 +218,10 @@ fn results_table(
                 @let r = w.row;
                 @let (placed, pieces) = w.placed();
                 @let (driven, nails) = w.driven();
-                tr data-wall=(r.wall_id) {
+                tr data-wall=(w.id) {
                     td {
-                        @if let Some(page) = pages { a href=(page(i)) { (r.name) " (" (r.wall_id) ")" } }
-                        @else { a href=(format!("#wall-{}", i + 1)) { (r.name) " (" (r.wall_id) ")" } }
+                        @if let Some(page) = pages { a href=(page(i)) { (r.name) " (" (w.id) ")" } }
+                        @else { a href=(format!("#wall-{}", i + 1)) { (r.name) " (" (w.id) ")" } }
                     }
                     td { (r.material_feeding) }
                     td { (r.framing.status) } td class="num" { (format!("{:.1} s", r.framing.time_s)) } td { (r.framing.failed_component) }
@@ -236,7 +239,7 @@ fn results_table(
 
 fn causes(w: &WallView) -> Markup {
     html! {
-        div class="causes" data-wall=(w.row.wall_id) {
+        div class="causes" data-wall=(w.id) {
             h3 { "Root causes in " (w.row.name) }
             @if w.causes.is_empty() { p { "None: every piece placed and every nail driven." } }
             ul {
@@ -258,27 +261,27 @@ fn causes(w: &WallView) -> Markup {
 
 fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
     let index = input
-        .report
-        .walls
+        .sim
+        .records
         .iter()
-        .position(|r| r.wall_id == w.row.wall_id)
+        .position(|r| r.wall == w.record.wall)
         .unwrap_or(0);
     let thickness = input
         .sim
         .plan
         .walls
         .iter()
-        .find(|p| p.id == w.row.wall_id)
+        .find(|p| p.id == w.id)
         .map_or(0.09, |p| p.thickness);
     let contacts: Vec<_> = input
         .report
         .contacts
         .iter()
-        .filter(|c| c.wall_id == w.row.wall_id)
+        .filter(|c| c.panel_id == w.row.panel_id)
         .collect();
     html! {
-        section class="wall" id=(format!("wall-{}", index + 1)) data-wall=(w.row.wall_id) {
-            h2 { (w.row.name) " (" (w.row.wall_id) ")" }
+        section class="wall" id=(format!("wall-{}", index + 1)) data-wall=(w.id) {
+            h2 { (w.row.name) " (" (w.id) ")" }
             p { "3D scene of the run: " a href=(scene) { (scene) } " (glTF 2.0; opens in any glTF viewer)." }
             h3 { "Elevation" }
             p { "Wall frame: u along the wall, v up; hover a piece for its IFC name, entity and reason." }
@@ -306,16 +309,17 @@ fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
 }
 
 /// The wall's panels, when it is split: one row each.
+/// Where a panel of a split wall lies in its wall, and the wall's other panels.
 fn panels(w: &WallView) -> Markup {
     let split = w.panels;
     html! {
-        @if split.panels.len() > 1 {
-            h3 { "Panels" }
-            p { (format!("The wall is longer or heavier than the cell builds: split into {} panels at the dashed lines (rules/panels.dl; framewright why MODEL {} explains a panel). The run above still frames the wall whole.", split.panels.len(), split.panels[0].id)) }
+        @if let Some(of) = w.panel {
+            h3 { "Panel" }
+            p { (format!("Panel {} of {} of {} ({}): the wall is longer or heavier than the cell builds, so it is built as {} panels (rules/panels.dl; framewright why MODEL {} explains this panel). This section frames and nails {} on its own; its cut plate segments (PLATE~k) and added end studs (STUD~endK) are pieces like any other.", of.index, split.panels.len(), of.wall_name, of.wall_id, split.panels.len(), of.panel_id, of.panel_id)) }
             table class="panels" {
                 tr { th { "panel" } th { "u from (m)" } th { "u to (m)" } th { "length (m)" } th { "height (m)" } th { "mass (kg)" } th { "members" } th { "plate segments" } th { "added end studs" } th { "exceeds" } }
                 @for p in &split.panels {
-                    tr {
+                    tr class=[(p.id == of.panel_id).then_some("this")] {
                         td { (p.id) }
                         td class="num" { (format!("{:.3}", p.u_start)) }
                         td class="num" { (format!("{:.3}", p.u_end)) }

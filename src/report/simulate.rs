@@ -111,6 +111,7 @@ pub struct NailingValidation {
 #[derive(Debug, Serialize)]
 pub struct NailRow {
     pub wall_id: String,
+    pub panel_id: String,
     pub plate: String,
     pub member: String,
     pub k: i64,
@@ -130,6 +131,7 @@ pub struct NailRow {
 #[derive(Debug, Serialize)]
 pub struct ContactRow {
     pub wall_id: String,
+    pub panel_id: String,
     pub element: String,
     pub op: String,
     pub t: f64,
@@ -351,6 +353,7 @@ impl SimReport {
                         ..
                     } => NailRow {
                         wall_id: wall_id(&rec.wall),
+                        panel_id: panel_id(&rec.wall),
                         plate: n.plate.clone(),
                         member: n.member.clone(),
                         k: n.k,
@@ -364,6 +367,7 @@ impl SimReport {
                     },
                     NailOutcome::Skipped { kind, .. } => NailRow {
                         wall_id: wall_id(&rec.wall),
+                        panel_id: panel_id(&rec.wall),
                         plate: n.plate.clone(),
                         member: n.member.clone(),
                         k: n.k,
@@ -381,6 +385,7 @@ impl SimReport {
             for c in &rec.contacts {
                 contacts.push(ContactRow {
                     wall_id: wall_id(&rec.wall),
+                    panel_id: panel_id(&rec.wall),
                     element: c.piece.clone(),
                     op: c.op.to_string(),
                     t: r6(c.t),
@@ -453,26 +458,45 @@ impl SimReport {
             "{:<24} {:<10} {:<10} {:>9} {:<16} {:<10} {:>9} {:<16}",
             "wall", "feeding", "framing", "time", "failed", "nailing", "time", "failed"
         );
-        for w in &self.walls {
-            let dash = |c: &str| {
-                if c.is_empty() {
-                    "-".to_string()
-                } else {
-                    c.to_string()
-                }
-            };
+        let dash = |c: &str| {
+            if c.is_empty() {
+                "-".to_string()
+            } else {
+                c.to_string()
+            }
+        };
+        let mut row = |name: String, feeding: &str, framing: &Stage, nailing: &Stage| {
             let _ = writeln!(
                 s,
                 "{:<24} {:<10} {:<10} {:>7.1} s {:<16} {:<10} {:>7.1} s {:<16}",
-                format!("{} ({})", w.name, short(&w.wall_id)),
-                w.material_feeding,
-                w.framing.status,
-                w.framing.time_s,
-                dash(&w.framing.failed_component),
-                w.nailing.status,
-                w.nailing.time_s,
-                dash(&w.nailing.failed_component),
+                name,
+                feeding,
+                framing.status,
+                framing.time_s,
+                dash(&framing.failed_component),
+                nailing.status,
+                nailing.time_s,
+                dash(&nailing.failed_component),
             );
+        };
+        for w in &self.walls {
+            let name = format!("{} ({})", w.name, short(&w.wall_id));
+            row(name, &w.material_feeding, &w.framing, &w.nailing);
+            // A split wall's panels below it, each as the cell built it.
+            let panels: Vec<&PanelRow> = self
+                .panels
+                .iter()
+                .filter(|p| p.wall_id == w.wall_id)
+                .collect();
+            if panels.len() > 1 {
+                for p in panels {
+                    let name = match p.panel_id.rsplit_once("-P") {
+                        Some((_, k)) => format!("  {}-P{k}", short(&p.wall_id)),
+                        None => format!("  {}", p.panel_id),
+                    };
+                    row(name, &p.material_feeding, &p.framing, &p.nailing);
+                }
+            }
         }
         s
     }

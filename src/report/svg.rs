@@ -119,18 +119,6 @@ pub(super) fn elevation(view: &WallView) -> Markup {
                     title { (n.label) }
                 }
             }
-            @if view.panels.panels.len() > 1 {
-                @for b in &view.panels.breaks {
-                    line class="panel-break" x1=(f1(x(b.u))) y1=(f1(MARGIN - 12.0)) x2=(f1(x(b.u))) y2=(f1(y(v0)))
-                        stroke="#0d47a1" stroke-width="2" stroke-dasharray="6 4" {
-                        title { (format!("panel break at u = {:.3} m: {}", b.u, b.reason)) }
-                    }
-                }
-                @for p in &view.panels.panels {
-                    text class="panel-label" x=(f1(x((p.u_start + p.u_end) / 2.0))) y=(f1(MARGIN - 6.0)) font-size="11"
-                        text-anchor="middle" fill="#0d47a1" { (format!("{} · {:.2} m", p.id, p.length())) }
-                }
-            }
             (scale_bar(MARGIN, height - 15.0, s))
         }
     }

@@ -3,8 +3,9 @@
 //! cell's top view, every nailing target, the wall's operations and figures.
 
 use super::causes::{RootCause, root_causes};
-use super::simulate::{SimReport, WallRow};
+use super::simulate::{PanelRow, SimReport};
 use super::verdict;
+use crate::frame::panelize::PanelOf;
 use crate::frame::panels::WallPanels;
 use crate::ifc::Model;
 use crate::sim::Simulation;
@@ -38,29 +39,37 @@ pub struct NailView {
 }
 
 pub struct WallView<'a> {
-    pub row: &'a WallRow,
+    /// The run's wall as the plan names it: `W1`, or `W1-P2` for a panel of a split wall.
+    pub id: &'a str,
+    /// Its verdict row: the panel the cell built.
+    pub row: &'a PanelRow,
     pub record: &'a WallRecord,
     pub pieces: Vec<PieceView>,
     pub nails: Vec<NailView>,
     pub causes: Vec<RootCause>,
     /// Smallest reach margin of the wall's solved pick and place poses (m).
     pub min_margin: Option<f64>,
-    /// The wall's panels (one when it fits the cell).
+    /// The wall's panels (one when it fits the cell); for a panel of a split wall, the whole
+    /// wall's.
     pub panels: &'a WallPanels,
+    /// The whole wall this is a panel of, when it was split.
+    pub panel: Option<&'a PanelOf>,
 }
 
 impl<'a> WallView<'a> {
-    /// The view of the wall `wall_id` (the report's id); `None` when the report has no such
-    /// wall. `model` supplies `#entity` numbers when given.
+    /// The view of the simulated wall `wall_id` (as the plan names it: a wall, or a panel of a
+    /// split wall); `None` when the simulation has no such wall. `model` (the simulation's,
+    /// `Simulation::model`) supplies `#entity` numbers when given.
     pub fn new(
         sim: &'a Simulation,
         report: &'a SimReport,
         model: Option<&Model>,
         wall_id: &str,
     ) -> Option<WallView<'a>> {
-        let row = report.walls.iter().find(|w| w.wall_id == wall_id)?;
         let plan_wall = sim.plan.walls.iter().find(|w| w.id == wall_id)?;
-        let record = sim.records.iter().find(|r| r.wall == plan_wall.key)?;
+        // The report's panel rows follow the records.
+        let at = sim.records.iter().position(|r| r.wall == plan_wall.key)?;
+        let (record, row) = (&sim.records[at], report.panels.get(at)?);
         let scene_wall = sim.scene.walls.iter().find(|w| w.id == plan_wall.key)?;
         let to_wall = scene_wall.wall_to_robot.inverse();
         let mut pieces = Vec::new();
@@ -153,6 +162,7 @@ impl<'a> WallView<'a> {
             .filter_map(|r| r.result.as_ref().ok().copied())
             .reduce(f64::min);
         Some(WallView {
+            id: &plan_wall.id,
             row,
             record,
             pieces,
@@ -160,6 +170,7 @@ impl<'a> WallView<'a> {
             causes: root_causes(report, wall_id),
             min_margin,
             panels: &plan_wall.panels,
+            panel: plan_wall.panel.as_ref().filter(|p| p.index > 0),
         })
     }
 

@@ -4,7 +4,7 @@
 
 use super::SimError;
 use crate::cell::{Cell, PanelMode};
-use crate::frame::panelize::{panelize, panels_by_piece};
+use crate::frame::panelize::panelize;
 use crate::frame::placement::add_placement_facts;
 use crate::frame::plan::Plan;
 use crate::frame::{Facts, Reasoned, RuleEngine, cell_facts, model_facts, reason};
@@ -82,7 +82,7 @@ pub fn prepare_facts(
     add_placement_facts(&mut facts, &whole_panels, engine)?;
     let reasoned = reason(&facts, engine, false)?;
     let mut panels = Plan::from_reasoned(&cut.model, &reasoned);
-    panels.name_after_panels(&panels_by_piece(&plan));
+    panels.name_after_panels(&plan);
     // What the split said about the whole walls (limits dropped, panels over a limit).
     let mut warnings = plan.panel_warnings();
     warnings.append(&mut panels.warnings);

@@ -141,7 +141,8 @@ fn wall_camera(wall: &Wall) -> Camera {
     }
 }
 
-/// The topics of a simulation, wall by wall in plan order, causes in a fixed order.
+/// The topics of a simulation, wall by wall in plan order, causes in a fixed order; `model` is
+/// the one the simulation ran on (`Simulation::model`: cut plates name their plate's GlobalId).
 pub fn topics_of(model: &Model, sim: &Simulation, header: &BcfHeader) -> Vec<IssueTopic> {
     let pieces: BTreeMap<&str, &crate::ifc::Piece> =
         model.pieces().iter().map(|p| (p.id.as_str(), p)).collect();
