@@ -145,6 +145,22 @@ fn a_long_wall_is_simulated_panel_by_panel_and_an_edit_redoes_one_panel() {
     for plate in &plates {
         assert!(!panels.values().any(|p| p.contains(*plate)));
     }
+    // BCF topics are about the panel the cell built, and each names its panel.
+    let bcf = dir.path().join("issues.bcfzip");
+    let again = simulate(&model, &cache, &["--bcf", bcf.to_str().unwrap()]);
+    assert_eq!(cache_counts(&again), (0, 3));
+    let titles: Vec<String> = common::bcf::xml_documents(&bcf)
+        .into_iter()
+        .filter(|(name, _)| name.ends_with("markup.bcf"))
+        .filter_map(|(_, xml)| {
+            let start = xml.find("<Title>")? + "<Title>".len();
+            Some(xml[start..start + xml[start..].find("</Title>")?].to_string())
+        })
+        .collect();
+    assert!(!titles.is_empty(), "the run fails somewhere on this cell");
+    for title in &titles {
+        assert!(title.contains(", panel "), "{title}");
+    }
     // Nails driven into cut plates and added studs land inside the pieces as built.
     let nails = &report["nailing_validation"];
     assert!(nails["checked"].as_u64().unwrap() > 0);
