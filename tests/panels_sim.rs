@@ -191,3 +191,64 @@ fn a_long_wall_is_simulated_panel_by_panel_and_an_edit_redoes_one_panel() {
         .collect();
     assert!(changed.len() <= 1, "{changed:?}");
 }
+
+#[test]
+fn the_three_storey_models_longest_wall_is_fed_and_judged_panel_by_panel() {
+    let Some(model) = common::shared_path("ifc-testcases/g_scale_3storey.ifc") else {
+        return;
+    };
+    let m = model.to_str().unwrap();
+    let plan = json_of(&["plan", m, "--json"]);
+    let wall = plan["walls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .max_by(|a, b| {
+            a["length"]
+                .as_f64()
+                .unwrap()
+                .total_cmp(&b["length"].as_f64().unwrap())
+        })
+        .unwrap();
+    let id = wall["wall_id"].as_str().unwrap();
+    let panels: Vec<&str> = wall["panels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["panel_id"].as_str().unwrap())
+        .collect();
+    assert!(wall["length"].as_f64().unwrap() > 50.0 && panels.len() >= 8);
+    let report = json_of(&["simulate", m, "--json", "--no-cache", "--wall", id]);
+    let rows = report["panels"].as_array().unwrap();
+    let row_ids: Vec<&str> = rows
+        .iter()
+        .map(|r| r["panel_id"].as_str().unwrap())
+        .collect();
+    assert_eq!(row_ids, panels);
+    for row in rows {
+        assert_eq!(row["wall_id"], id);
+        assert_eq!(row["material_feeding"], "Completed", "{row}");
+    }
+    // No piece is refused by the conveyors; whole, the wall's plates are.
+    let refused = |report: &Value| -> usize {
+        report["elements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|e| e["framing"]["reasons"].as_array().unwrap())
+            .filter(|r| r["message"].as_str().unwrap().contains("cannot carry"))
+            .count()
+    };
+    assert_eq!(refused(&report), 0);
+    let whole = json_of(&[
+        "simulate",
+        m,
+        "--json",
+        "--no-cache",
+        "--wall",
+        id,
+        "--panels",
+        "off",
+    ]);
+    assert!(refused(&whole) > 0);
+}
