@@ -166,6 +166,29 @@ fn a_long_wall_is_simulated_panel_by_panel_and_an_edit_redoes_one_panel() {
     assert!(nails["checked"].as_u64().unwrap() > 0);
     assert_eq!(nails["all_inside_members"], true);
 
+    // `why` explains a failure in a split wall by the panel it was built in: every wall size in
+    // its derivation is a panel's, none the whole 20 m wall's.
+    let failed = report["elements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["framing"]["status"] == "failed" && !e["id"].as_str().unwrap().contains('~'))
+        .expect("a modelled piece fails on this cell");
+    let why = framewright(&["why", m, failed["id"].as_str().unwrap(), "--no-cache"]);
+    assert!(
+        why.status.success(),
+        "{}",
+        String::from_utf8_lossy(&why.stderr)
+    );
+    let text = String::from_utf8_lossy(&why.stdout);
+    let sizes: Vec<f64> = text
+        .split("wall_size(\"")
+        .skip(1)
+        .filter_map(|rest| rest.split(", ").nth(1)?.parse().ok())
+        .collect();
+    assert!(!sizes.is_empty(), "{text}");
+    assert!(sizes.iter().all(|l| *l <= 7.5 + 1e-6), "{sizes:?}");
+
     // Move a stud that no break lies beside: the breaks stay, one panel is simulated again.
     let text = std::fs::read_to_string(&model).unwrap();
     let moved = dir.path().join("moved.ifc");

@@ -11,10 +11,11 @@ use framewright::frame::panel_why;
 use framewright::frame::placement::{add_placement_facts, reason_placed};
 use framewright::frame::plan::Plan;
 use framewright::logic::compiled::Relations;
+use framewright::sim::{prepare_facts, whole_facts};
 use framewright::user_rules::render::{render_why, render_why_not};
 use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
 use framewright::user_rules::why::{
-    Context, WhyError, element_walls, resolve_element, why, why_not,
+    Context, WhyError, element_walls_split, resolve_element, why, why_not,
 };
 use serde::Serialize;
 use std::collections::BTreeSet;
@@ -71,7 +72,9 @@ struct Simulated {
 }
 
 /// Adds the executor's facts of the walls of the pieces in `ids` (each wall
-/// simulated once, then cached), unless `--no-simulate`.
+/// simulated once, then cached), unless `--no-simulate`. A wall the rules split is simulated
+/// panel by panel on the model cut into panels: `facts` become that model's (the element's
+/// containers), and the model is returned, for the explanation to name its pieces.
 fn simulate_walls(
     c: &Common,
     model_path: &std::path::Path,
@@ -79,9 +82,9 @@ fn simulate_walls(
     cell: &framewright::cell::Cell,
     facts: &mut framewright::frame::Facts,
     ids: &[String],
-) -> Result<Vec<Simulated>, Failure> {
+) -> Result<(Vec<Simulated>, Option<framewright::ifc::Model>), Failure> {
     if c.no_simulate {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), None));
     }
     let base = rule_base(&c.inputs.rules_dir);
     let ctx = Context {
@@ -91,13 +94,32 @@ fn simulate_walls(
         user_files: &c.rules,
     };
     let mut walls = Vec::new();
+    let mut split = false;
     for id in ids {
-        for w in element_walls(&ctx, id).map_err(failure)? {
+        let (of, any) = element_walls_split(&ctx, id).map_err(failure)?;
+        split |= any;
+        for w in of {
             if !walls.contains(&w) {
                 walls.push(w);
             }
         }
     }
+    let panelized = if split {
+        let pieces: BTreeSet<String> = ids
+            .iter()
+            .filter_map(|id| resolve_element(model, id).ok())
+            .flatten()
+            .map(|p| p.id.clone())
+            .collect();
+        let whole = whole_facts(model, cell);
+        let keep = containers_of(&whole, &pieces.iter().map(String::as_str).collect());
+        let restrict = |f: framewright::frame::Facts| restrict_to_containers(&f, &keep);
+        let prepared = prepare_facts(model, "model", cell, &base, restrict(whole), &restrict)?;
+        *facts = prepared.facts;
+        prepared.panelized
+    } else {
+        None
+    };
     let cache = if c.no_cache {
         None
     } else {
@@ -113,7 +135,7 @@ fn simulate_walls(
             from_cache: cached,
         });
     }
-    Ok(out)
+    Ok((out, panelized))
 }
 
 #[derive(Serialize)]
@@ -169,7 +191,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
     let mut facts = restrict_to_containers(&facts, &containers_of(&facts, &ids));
     add_placement_facts(&mut facts, &cell, &base)?;
-    let simulated = simulate_walls(
+    let (simulated, panelized) = simulate_walls(
         c,
         &args.model,
         &model,
@@ -178,7 +200,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         std::slice::from_ref(&args.id),
     )?;
     let ctx = Context {
-        model: &model,
+        model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,
         base: &base,
         user_files: &c.rules,
@@ -235,9 +257,9 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     }
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
     let ids = piece_ids_in(&model, &args.tuple);
-    simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
+    let (_, panelized) = simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
     let ctx = Context {
-        model: &model,
+        model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,
         base: &base,
         user_files: &c.rules,

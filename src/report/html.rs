@@ -29,6 +29,7 @@ table { border-collapse: collapse; margin: 0.5em 0 1em; font-size: 13px; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
 section.wall { border-top: 2px solid #455a64; margin-top: 2em; }
+table.panels tr.this td { font-weight: bold; background: #e3f2fd; }
 .legend span { display: inline-block; padding: 0 6px; margin-right: 6px; border: 1px solid #333; font-size: 12px; }
 .causes li { margin: 0.3em 0; }
 svg { display: block; margin: 0.5em 0; background: #fafafa; border: 1px solid #ddd; }

@@ -6,6 +6,7 @@
 //! framewright version and the executor's source); a stale or unreadable
 //! entry is simulated again, never trusted.
 
+use crate::cache::key::build_id_noted;
 use crate::cell::Cell;
 use crate::frame::{Facts, RuleEngine};
 use crate::ifc::Model;
@@ -64,9 +65,14 @@ pub fn wall_sim_facts(
     engine: &RuleEngine,
     cache_dir: Option<&Path>,
 ) -> Result<(Facts, bool), SimCacheError> {
-    let key = cache_key(model_path, cell, wall, engine)?;
-    let file = cache_dir.map(|d| d.join(format!("sim-{key}.json")));
-    if let Some(facts) = file.as_deref().and_then(|f| read_entry(f, &key)) {
+    let entry = match cache_dir {
+        Some(dir) => {
+            let key = cache_key(model_path, cell, wall, engine, build_id_noted(dir))?;
+            Some((dir.join(format!("sim-{key}.json")), key))
+        }
+        None => None,
+    };
+    if let Some(facts) = entry.as_ref().and_then(|(f, key)| read_entry(f, key)) {
         return Ok((facts, true));
     }
     let options = SimOptions {
@@ -75,7 +81,7 @@ pub fn wall_sim_facts(
         ..SimOptions::default()
     };
     let facts = simulate_wall_facts(model, cell, &options)?;
-    if let Some(f) = file {
+    if let Some((f, key)) = entry {
         // A cache that cannot be written only costs the next run a simulation.
         let _ = write_entry(&f, &key, &facts);
     }
@@ -100,6 +106,7 @@ fn cache_key(
     cell: &Cell,
     wall: &str,
     engine: &RuleEngine,
+    build: &str,
 ) -> Result<String, SimCacheError> {
     let bytes = std::fs::read(model_path).map_err(|e| SimCacheError::Model {
         path: model_path.to_path_buf(),
@@ -112,10 +119,9 @@ fn cache_key(
     // The cell as loaded: layout, robot (links, collision shapes, limits) and tool, whichever
     // files they came from.
     format!("{cell:?}").hash(&mut h);
-    // The executor itself: a changed simulation must not be answered from an old entry.
-    for text in SIM_SOURCES {
-        text.hash(&mut h);
-    }
+    // The build itself (the main cache's identity: a hash of the executable), so a changed
+    // executor, planner or pipeline is never answered from an old entry.
+    build.hash(&mut h);
     wall.hash(&mut h);
     match engine {
         RuleEngine::Directory(dir) => {
@@ -134,24 +140,6 @@ fn cache_key(
     }
     Ok(format!("{:016x}", h.finish()))
 }
-
-/// The executor's source, part of the cache key (the package version does not change between
-/// builds of a working copy).
-const SIM_SOURCES: [&str; 13] = [
-    include_str!("../sim/mod.rs"),
-    include_str!("../sim/executor/mod.rs"),
-    include_str!("../sim/executor/feeding.rs"),
-    include_str!("../sim/executor/framing.rs"),
-    include_str!("../sim/executor/nailing.rs"),
-    include_str!("../sim/executor/paths.rs"),
-    include_str!("../sim/executor/as_built.rs"),
-    include_str!("../frame/placement.rs"),
-    include_str!("../cell/tcp_poses.rs"),
-    include_str!("../sim/physics.rs"),
-    include_str!("../sim/motion.rs"),
-    include_str!("../sim/reach.rs"),
-    include_str!("../sim/record.rs"),
-];
 
 #[derive(Default)]
 struct Fnv(u64);

@@ -137,6 +137,11 @@ fn unknown_element(model: &Model, id: &str) -> String {
 /// The walls (keys, as in `wall_of`) of the pieces an ID names, from the
 /// rule base run over their containers only.
 pub fn element_walls(ctx: &Context<'_>, id: &str) -> Result<Vec<String>, WhyError> {
+    Ok(element_walls_split(ctx, id)?.0)
+}
+
+/// `element_walls`, and whether the rules split any of them into panels (`wall_split`).
+pub fn element_walls_split(ctx: &Context<'_>, id: &str) -> Result<(Vec<String>, bool), WhyError> {
     let pieces = resolve_element(ctx.model, id)?;
     let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
     let facts = restrict_to_containers(ctx.facts, &containers_of(ctx.facts, &ids));
@@ -148,7 +153,11 @@ pub fn element_walls(ctx: &Context<'_>, id: &str) -> Result<Vec<String>, WhyErro
         .filter(|t| t[0].as_symbol().is_some_and(|p| ids.contains(p)))
         .filter_map(|t| t[1].as_symbol().map(str::to_string))
         .collect();
-    Ok(walls.into_iter().collect())
+    let split = reasoned
+        .get("wall_split")
+        .iter()
+        .any(|t| t[0].as_symbol().is_some_and(|w| walls.contains(w)));
+    Ok((walls.into_iter().collect(), split))
 }
 
 /// Runs the base (+ user rules) with provenance over `facts`.
