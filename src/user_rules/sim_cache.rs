@@ -245,8 +245,11 @@ mod tests {
     fn the_key_changes_with_the_robot_and_tool_geometry() {
         let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm1.ifc");
         let cell = Cell::load("study-abb").unwrap();
-        let key = |c: &Cell| cache_key(&model, c, "W1", &RuleEngine::Compiled).unwrap();
+        let key = |c: &Cell| cache_key(&model, c, "W1", &RuleEngine::Compiled, "b").unwrap();
         assert_eq!(key(&cell), key(&cell.clone()));
+        // Another build: another key.
+        let other = cache_key(&model, &cell, "W1", &RuleEngine::Compiled, "c").unwrap();
+        assert_ne!(key(&cell), other);
         // A tool part moved 10 mm: no cell key or fact changes, the simulation does.
         let mut moved = cell.clone();
         moved.tool.parts[1].shape.origin.translation.x += 0.01;
