@@ -472,8 +472,6 @@ fn check_panels_unlimited(plan: &Value) -> usize {
         .sum()
 }
 
-/// The model with the stud whose placement point is `point` moved `du` along its wall (a
-/// `--grouping wall` model places members in their wall's frame, x along the wall).
 #[test]
 fn moving_one_stud_moves_at_most_the_break_beside_it() {
     let dir = tempfile::tempdir().unwrap();

@@ -164,6 +164,25 @@ fn products(model: &Model) -> Vec<(u64, Vec<&Piece>)> {
     order
 }
 
+/// A body: `profile` swept `depth` (model units) along its placement's z axis, in the body
+/// representation context `context`.
+pub(super) fn swept_body(w: &mut Appender, context: u64, profile: Ref, depth: f64) -> Ref {
+    let up = w.add("IFCDIRECTION", "(0.,0.,1.)");
+    let solid = w.add(
+        "IFCEXTRUDEDAREASOLID",
+        format!("{profile},$,{up},{}", Real(depth)),
+    );
+    let rep = w.add(
+        "IFCSHAPEREPRESENTATION",
+        format!(
+            "#{context},{},{},({solid})",
+            string("Body"),
+            string("SweptSolid")
+        ),
+    );
+    w.add("IFCPRODUCTDEFINITIONSHAPE", format!("$,$,({rep})"))
+}
+
 /// One property: a single value for a one-piece product, a list (one value per piece) otherwise.
 pub(super) fn property(w: &mut Appender, name: &str, values: &[String]) -> Ref {
     if let [value] = values {
@@ -621,20 +640,7 @@ fn write_nails(
                 Real(nail.diameter / 2.0 / unit)
             ),
         );
-        let up = w.add("IFCDIRECTION", "(0.,0.,1.)");
-        let solid = w.add(
-            "IFCEXTRUDEDAREASOLID",
-            format!("{profile},$,{up},{}", Real(nail.length / unit)),
-        );
-        let rep = w.add(
-            "IFCSHAPEREPRESENTATION",
-            format!(
-                "#{context},{},{},({solid})",
-                string("Body"),
-                string("SweptSolid")
-            ),
-        );
-        w.add("IFCPRODUCTDEFINITIONSHAPE", format!("$,$,({rep})"))
+        swept_body(w, context, profile, nail.length / unit)
     });
     let mut count = 0;
     // (plate product, member product) → nails; container → nails.

@@ -11,7 +11,7 @@
 //!   assigned to the panel instead (`IfcRelAssignsToProduct`).
 //! - The assembly is contained where its wall's first piece is.
 
-use super::annotate::{ElementVerdict, PSET_NAME, guid_for, label, property, typed};
+use super::annotate::{ElementVerdict, PSET_NAME, guid_for, label, property, swept_body, typed};
 use super::step_edit::Appender;
 use crate::frame::panelize::{moved_box, segment_box};
 use crate::frame::plan::Plan;
@@ -223,20 +223,7 @@ fn write_member(
             ),
         );
         // The profile centred on the placement's axis: the solid sits at the box.
-        let up = w.add("IFCDIRECTION", "(0.,0.,1.)");
-        let solid = w.add(
-            "IFCEXTRUDEDAREASOLID",
-            format!("{profile},$,{up},{}", Real(2.0 * b.half[0] / unit)),
-        );
-        let rep = w.add(
-            "IFCSHAPEREPRESENTATION",
-            format!(
-                "#{context},{},{},({solid})",
-                string("Body"),
-                string("SweptSolid")
-            ),
-        );
-        w.add("IFCPRODUCTDEFINITIONSHAPE", format!("$,$,({rep})"))
+        swept_body(w, context, profile, 2.0 * b.half[0] / unit)
     });
     let what = if m.kind == "PLATE" {
         "segment of plate"

@@ -2,7 +2,8 @@
 
 use std::collections::BTreeMap;
 
-/// `text` with the IfcCartesianPoint `point` (`#id`) moved by `du` along x.
+/// `text` with the IfcCartesianPoint `point` (`#id`) moved by `du` along x: in a
+/// `--grouping wall` model, which places members in their wall's frame, along the wall.
 pub fn move_point(text: &str, point: &str, du: f64) -> String {
     let line = text
         .lines()
