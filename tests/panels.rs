@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::ifc_edit::{move_point, stud_points};
+use common::ifc_edit::{long_wall, move_point, stud_points};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -476,19 +476,7 @@ fn check_panels_unlimited(plan: &Value) -> usize {
 fn moving_one_stud_moves_at_most_the_break_beside_it() {
     let dir = tempfile::tempdir().unwrap();
     let base = dir.path().join("long.ifc");
-    let out = framewright(&[
-        "synth",
-        "wall",
-        "--length",
-        "20",
-        "--grouping",
-        "wall",
-        "--window",
-        "5.0,1.2,1.2,0.9",
-        "-o",
-        base.to_str().unwrap(),
-    ]);
-    assert!(out.status.success());
+    long_wall(&base);
     let text = std::fs::read_to_string(&base).unwrap();
     let breaks = |plan: &Value| -> Vec<f64> {
         plan["walls"][0]["panel_breaks"]

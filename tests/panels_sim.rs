@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::ifc_edit::{move_point, stud_points};
+use common::ifc_edit::{long_wall, move_point, stud_points};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -76,19 +76,7 @@ fn cache_counts(report: &Value) -> (u64, u64) {
 fn a_long_wall_is_simulated_panel_by_panel_and_an_edit_redoes_one_panel() {
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("long.ifc");
-    let out = framewright(&[
-        "synth",
-        "wall",
-        "--length",
-        "20",
-        "--grouping",
-        "wall",
-        "--window",
-        "5.0,1.2,1.2,0.9",
-        "-o",
-        model.to_str().unwrap(),
-    ]);
-    assert!(out.status.success());
+    long_wall(&model);
     let m = model.to_str().unwrap();
     let plan = json_of(&["plan", m, "--json", "--no-cache"]);
     let wall_id = plan["walls"][0]["wall_id"].as_str().unwrap().to_string();

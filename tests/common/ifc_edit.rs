@@ -1,6 +1,23 @@
 //! Small edits of the synthetic models' IFC text: the tests move a stud and see what follows.
 
 use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Writes a 20 m wall with a window at 5 m, its members grouped in an IfcWall: three panels on
+/// a cell that carries 7.5 m.
+pub fn long_wall(path: &Path) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(["synth", "wall", "--length", "20", "--grouping", "wall"])
+        .args(["--window", "5.0,1.2,1.2,0.9", "-o"])
+        .arg(path)
+        .output()
+        .expect("framewright runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
 
 /// `text` with the IfcCartesianPoint `point` (`#id`) moved by `du` along x: in a
 /// `--grouping wall` model, which places members in their wall's frame, along the wall.
