@@ -194,6 +194,14 @@ fn a_long_wall_is_simulated_panel_by_panel_and_an_edit_redoes_one_panel() {
     std::fs::write(&moved, move_point(&text, point, 0.02)).unwrap();
     let again = simulate(&moved, &cache, &[]);
     assert_eq!(cache_counts(&again), (1, 2), "moving {point}");
+    // `diff` compares panel with panel: the model against itself changes no wall; moving one
+    // stud along its wall changes that stud and no panel's extent or members.
+    let diff = |new: &Path| json_of(&["diff", m, new.to_str().unwrap(), "--json", "--no-cache"]);
+    let same = diff(&model);
+    assert!(same["walls"].as_array().unwrap().is_empty(), "{same}");
+    let edited = diff(&moved);
+    assert!(edited["walls"].as_array().unwrap().is_empty(), "{edited}");
+    assert_eq!(edited["elements"].as_array().unwrap().len(), 1, "{edited}");
     let changed: Vec<&str> = rows
         .iter()
         .zip(again["panels"].as_array().unwrap())

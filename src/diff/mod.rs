@@ -114,9 +114,14 @@ fn piece_name(p: &Piece) -> String {
     p.name.clone().unwrap_or_else(|| p.ifc_type.clone())
 }
 
-/// A wall's identity across versions: the IFC group that is the wall, else its key piece.
+/// A wall's identity across versions: a panel of a split wall by its panel id (its whole wall's
+/// identity and its number along the wall), else the IFC group that is the wall, else its key
+/// piece.
 fn wall_identity(w: &Wall) -> &str {
-    w.group_global_id.as_deref().unwrap_or(&w.key)
+    match &w.panel {
+        Some(p) if p.index > 0 => &p.panel_id,
+        _ => w.group_global_id.as_deref().unwrap_or(&w.key),
+    }
 }
 
 pub fn diff(old: &Version, new: &Version) -> ModelDiff {
