@@ -7,7 +7,7 @@ use crate::cell::{Cell, PanelMode};
 use crate::frame::panelize::panelize;
 use crate::frame::placement::add_placement_facts;
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, Reasoned, RuleEngine, cell_facts, model_facts, reason};
+use crate::frame::{Facts, RuleEngine, cell_facts, model_facts, reason};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
 use crate::world::Scene;
@@ -17,7 +17,6 @@ pub struct Prepared {
     /// The facts reasoned: the model's (cut into panels when a wall was split), the cell's and
     /// the placement's. A run's verdicts are reasoned over these and its records' facts.
     pub facts: Facts,
-    pub reasoned: Reasoned,
     pub scene: Scene,
     /// One wall per panel the cell builds (a wall that fits is one).
     pub plan: Plan,
@@ -67,7 +66,6 @@ pub fn prepare_facts(
         let scene = Scene::build(model_name, model, cell, &reasoned)?;
         return Ok(Prepared {
             facts,
-            reasoned,
             scene,
             plan,
             panelized: None,
@@ -90,7 +88,6 @@ pub fn prepare_facts(
     let scene = Scene::build(model_name, &cut.model, cell, &reasoned)?;
     Ok(Prepared {
         facts,
-        reasoned,
         scene,
         plan: panels,
         panelized: Some(cut.model),
