@@ -187,6 +187,32 @@ def check_panels(plan, out, piece_gid):
                 if abs(u.min() - piece["u_start"]) > 1e-3 or abs(u.max() - piece["u_end"]) > 1e-3:
                     bad.append(f"{tag}: u {u.min():.4f}..{u.max():.4f}, planned {piece['u_start']:.4f}..{piece['u_end']:.4f}")
             check(not bad, f"{p['panel_id']}: the new members' bodies span their planned u ranges {bad[:3]}")
+        check_site_pieces(w, out, settings, origin, along, assemblies)
+
+
+def check_site_pieces(wall, out, settings, origin, along, assemblies):
+    """Each site piece (a lapped plate across a joint) is a new IfcMember in no panel,
+    contained in a storey, whose body spans its planned u range."""
+    sites = wall.get("site_pieces", [])
+    if not sites:
+        return
+    members = {m.Tag: m for m in out.by_type("IfcMember")}
+    in_panel = set()
+    for a in assemblies.values():
+        for rel in a.IsDecomposedBy:
+            in_panel |= {o.Tag for o in rel.RelatedObjects}
+    bad = []
+    for site in sites:
+        m = members.get(site["id"])
+        if m is None or site["id"] in in_panel or not m.ContainedInStructure:
+            bad.append(f"{site['id']}: missing, in a panel or in no storey")
+            continue
+        shape = ifcopenshell.geom.create_shape(settings, m)
+        verts = numpy.array(shape.geometry.verts).reshape(-1, 3)
+        u = (verts - origin) @ along
+        if abs(u.min() - site["u_start"]) > 1e-3 or abs(u.max() - site["u_end"]) > 1e-3:
+            bad.append(f"{site['id']}: u {u.min():.4f}..{u.max():.4f}, planned {site['u_start']:.4f}..{site['u_end']:.4f}")
+    check(not bad, f"{wall['wall_id']}: {len(sites)} site pieces written apart from the panels {bad[:3]}")
 
 
 if __name__ == "__main__":

@@ -169,6 +169,45 @@ fn check_panels(plan: &Value, context: &str) -> usize {
                 segments.entry(of).or_default().push((s, e, f(&c["mass"])));
             }
         }
+        // Cap plates lap over the joints: the stretch across each joint is a site piece, in no
+        // panel, and every joint of a cap lies at least the lap from every break.
+        let lap = f(&plan["panel_limits"]["cap_lap"]);
+        for site in wall["site_pieces"].as_array().unwrap() {
+            let of = site["of"].as_str().unwrap();
+            let (s, e) = (f(&site["u_start"]), f(&site["u_end"]));
+            assert_eq!(members[of].role, "cap_plate", "{at}: site piece of {of}");
+            assert!(
+                breaks.iter().any(|&u| u > s && u < e),
+                "{at}: site piece {} spans no joint",
+                site["id"]
+            );
+            segments
+                .entry(of)
+                .or_default()
+                .push((s, e, f(&site["mass"])));
+        }
+        for (id, segs) in &mut segments {
+            segs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let m = &members[id];
+            let joints = segs[1..].iter().map(|s| s.0);
+            for joint in joints {
+                let offset = breaks
+                    .iter()
+                    .map(|u| (u - joint).abs())
+                    .fold(f64::INFINITY, f64::min);
+                if m.role == "cap_plate" {
+                    assert!(
+                        offset >= lap - 1e-6,
+                        "{at}: {id} has a joint at u = {joint}, {offset} m from a break"
+                    );
+                } else {
+                    assert!(
+                        offset < 1e-6,
+                        "{at}: {id} has a joint at u = {joint} off the breaks"
+                    );
+                }
+            }
+        }
         for (id, m) in &members {
             match (whole.get(id), segments.get(id)) {
                 (Some(1), None) => {}
@@ -313,6 +352,16 @@ fn the_three_storey_model_has_no_piece_longer_than_the_conveyors() {
     };
     let plan = plan(&model, &[]);
     assert!(check_panels(&plan, "3-storey") >= 6);
+    // Its walls have cap plates: every split wall ties its panels with site pieces.
+    for wall in plan["walls"].as_array().unwrap() {
+        let joints = wall["panels"].as_array().unwrap().len() - 1;
+        let sites = wall["site_pieces"].as_array().unwrap().len();
+        assert!(
+            sites >= joints.min(1),
+            "{}: {sites} site pieces",
+            wall["wall_id"]
+        );
+    }
     let lengths: BTreeMap<&str, f64> = plan["members"]
         .as_array()
         .unwrap()
@@ -646,6 +695,17 @@ fn why_explains_panels_segments_added_studs_and_breaks_not_made() {
     let text = stdout_of(&["why", m, segment]);
     assert!(
         text.contains("a segment of") && text.contains("in panel W1-P2"),
+        "{text}"
+    );
+    // The cap's stretch across the first joint: a site piece, held back the cell's lap.
+    let site = &wall["site_pieces"][0];
+    let lap = f(&plan["panel_limits"]["cap_lap"]);
+    assert!((f(&site["length"]) - 2.0 * lap).abs() < 1e-6, "{site}");
+    let text = stdout_of(&["why", m, site["id"].as_str().unwrap()]);
+    assert!(
+        text.contains("across the joint of panels W1-P1 and W1-P2")
+            && text.contains(&format!("held back {lap:.3} m"))
+            && text.contains("cap_plate_laps"),
         "{text}"
     );
     let added = panels

@@ -228,6 +228,13 @@ impl<'a> PlanIndex<'a> {
                     entry.push_str(&format!(" {} ({})", cut.id, panel.id));
                 }
             }
+            for site in &wall.panels.site_pieces {
+                let entry = index
+                    .panel
+                    .entry(&site.of)
+                    .or_insert_with(|| "cut into".into());
+                entry.push_str(&format!(" {} (site)", site.id));
+            }
         }
         for wall in &plan.walls {
             for (i, p) in wall.assembly_order.iter().enumerate() {

@@ -9,7 +9,9 @@
 //!   aggregates (`IfcRelAggregates`); a modelled member that already belongs to an element
 //!   (an `IfcWall`, an `IfcElementAssembly` of the model) can have only one whole, so it is
 //!   assigned to the panel instead (`IfcRelAssignsToProduct`).
-//! - The assembly is contained where its wall's first piece is.
+//! - The assembly is contained where its wall's first piece is, and so is each site piece (the
+//!   stretch of a lapped cap plate across a joint: a new `IfcMember` in no panel, `Panel` =
+//!   `site`).
 
 use super::annotate::{ElementVerdict, PSET_NAME, guid_for, label, property, swept_body, typed};
 use super::step_edit::Appender;
@@ -35,6 +37,8 @@ struct NewMember<'a> {
     obox: OrientedBox,
     /// `PLATE` or `STUD`.
     kind: &'static str,
+    /// What it is, before the GlobalId of the piece it comes from.
+    what: String,
 }
 
 /// Writes the panels of `plan`'s split walls; `context` is the model's body context (no
@@ -74,6 +78,7 @@ pub(super) fn write_panels(
                         role: plan.roles.get(&cut.of).map_or("", String::as_str),
                         obox: segment_box(&of.obox, wall, cut.u_start, cut.u_end),
                         kind: "PLATE",
+                        what: "segment of plate".into(),
                     });
                 }
             }
@@ -85,6 +90,7 @@ pub(super) fn write_panels(
                         role: &added.role,
                         obox: moved_box(&of.obox, wall, added.u_start, added.u_end),
                         kind: "STUD",
+                        what: "end stud added beside".into(),
                     });
                 }
             }
@@ -168,6 +174,27 @@ pub(super) fn write_panels(
                 );
             }
         }
+        let mut contained = assemblies;
+        for site in &wall.panels.site_pieces {
+            let Some(of) = pieces.get(site.of.as_str()) else {
+                continue;
+            };
+            let m = NewMember {
+                id: &site.id,
+                of,
+                role: plan.roles.get(&site.of).map_or("", String::as_str),
+                obox: segment_box(&of.obox, wall, site.u_start, site.u_end),
+                kind: "PLATE",
+                what: format!(
+                    "lap across the joint of {}, fixed on site, from plate",
+                    site.laps.join(" and ")
+                ),
+            };
+            contained.push(write_member(
+                w, &m, "site", &wall.id, context, unit, verdicts,
+            ));
+            written.members += 1;
+        }
         if let Some(c) = container {
             w.add(
                 "IFCRELCONTAINEDINSPATIALSTRUCTURE",
@@ -175,7 +202,7 @@ pub(super) fn write_panels(
                     "{},$,{},$,{},#{c}",
                     guid_for("panel-contained", wall_key),
                     string("Panels"),
-                    RefList(&assemblies)
+                    RefList(&contained)
                 ),
             );
         }
@@ -225,18 +252,13 @@ fn write_member(
         // The profile centred on the placement's axis: the solid sits at the box.
         swept_body(w, context, profile, 2.0 * b.half[0] / unit)
     });
-    let what = if m.kind == "PLATE" {
-        "segment of plate"
-    } else {
-        "end stud added beside"
-    };
     let member = w.add(
         "IFCMEMBER",
         format!(
             "{},$,{},{},$,{placement},{},{},.{}.",
             guid_for("panel-member", m.id),
             label(m.of.name.as_deref().unwrap_or(m.id)),
-            string(&format!("{panel}: {what} {}", m.of.global_id)),
+            string(&format!("{panel}: {} {}", m.what, m.of.global_id)),
             shape.map_or("$".to_string(), |s| s.to_string()),
             label(m.id),
             m.kind,

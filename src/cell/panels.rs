@@ -19,6 +19,11 @@ pub struct PanelLimits {
     pub max_mass: f64,
     /// Shortest panel a break may leave, m. Default 1.2 (the lines' shortest element).
     pub min_length: f64,
+    /// How far a cap plate's joints lie from a panel break, m: the cap is held back this far
+    /// on both sides of the break and the piece across the joint is fixed on site (0: the cap
+    /// is cut at the break like the other plates). Default 0.61: the least offset of end
+    /// joints in double top plates in the International Residential Code (R602.3.2, 24 in).
+    pub cap_lap: f64,
 }
 
 impl Default for PanelLimits {
@@ -28,6 +33,7 @@ impl Default for PanelLimits {
             max_height: 3.5,
             max_mass: 1000.0,
             min_length: 1.2,
+            cap_lap: 0.61,
         }
     }
 }
@@ -76,6 +82,15 @@ impl PanelLimits {
                     format!("expected a value in {unit} above 0 and at most {max}, got {v}"),
                 ));
             }
+        }
+        if !(self.cap_lap.is_finite() && (0.0..=5.0).contains(&self.cap_lap)) {
+            return Err((
+                "cap_lap",
+                format!(
+                    "expected a value in m from 0 (no lap) to 5, got {}",
+                    self.cap_lap
+                ),
+            ));
         }
         let longest = self.max_length.min(carry);
         if self.min_length >= longest {

@@ -26,7 +26,7 @@ pub struct WhyArgs {
     /// The IFC model.
     pub model: PathBuf,
     /// A piece id, an IFC GlobalId or an entity `#id`; or a panel (`W1-P2`), a plate segment
-    /// (`PLATE~2`) or an added end stud (`STUD~end2`) of the plan.
+    /// (`PLATE~2`), an added end stud (`STUD~end2`) or a site piece (`CAP~lap1`) of the plan.
     pub id: String,
     #[command(flatten)]
     pub common: Common,
@@ -179,7 +179,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         let (plan, _) = plan_of(facts, &cell, &base, &model)?;
         let answer = panel_why::why(&plan, &cell, &args.id).ok_or_else(|| {
             Failure::bad_input(format!(
-                "`{}` names no panel, plate segment or added stud of the plan (panels are WALL-Pn, segments PLATE~k, added studs STUD~endN; `framewright plan --json` lists them)",
+                "`{}` names no panel, plate segment, added stud or site piece of the plan (panels are WALL-Pn, segments PLATE~k, added studs STUD~endN, site pieces PLATE~lapK; `framewright plan --json` lists them)",
                 args.id
             ))
         })?;

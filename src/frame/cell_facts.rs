@@ -26,7 +26,7 @@
 //! | `tool_mass` | value | mass of the end effector, kg |
 //! | `gripper_spacing`, `gripper_open_width`, `gripper_closed_width` | value | the tool's grippers (absent for a tool without) |
 //! | `carry_length` | value | the longest piece the conveyors carry (conveyor 2's length, conveyor 1's width side by side or length end to end) |
-//! | `panel_max_length`, `panel_max_height`, `panel_max_mass`, `panel_min_length` | value | `[panels]` of the cell file (m, kg) |
+//! | `panel_max_length`, `panel_max_height`, `panel_max_mass`, `panel_min_length`, `panel_cap_lap` | value | `[panels]` of the cell file (m, kg) |
 //! | `panels` | choice | `auto` (walls split into panels by `rules/panels.dl`) or `off` (`--panels off`: every wall one panel) |
 //! | `cell_name`, `robot_name`, `tool_name` | choice | names, for messages |
 
@@ -81,6 +81,7 @@ pub fn cell_facts(cell: &Cell) -> Facts {
     value("panel_max_height", p.max_height);
     value("panel_max_mass", p.max_mass);
     value("panel_min_length", p.min_length);
+    value("panel_cap_lap", p.cap_lap);
 
     let mut choice = |key: &str, s: &str| {
         facts.add(

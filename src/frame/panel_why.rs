@@ -67,6 +67,7 @@ pub fn why(plan: &Plan, cell: &Cell, id: &str) -> Option<PanelWhy> {
                     c.of,
                     cuts.join(", ")
                 ));
+                lines.extend(lap_line(&wall.panels, &c.of, limits.cap_lap));
                 lines.extend(context());
                 return Some(answer(id, "cut_piece", wall, Some(panel), lines));
             }
@@ -88,21 +89,59 @@ pub fn why(plan: &Plan, cell: &Cell, id: &str) -> Option<PanelWhy> {
                 return Some(answer(id, "added_piece", wall, Some(panel), lines));
             }
         }
+        if let Some(s) = wall.panels.site_pieces.iter().find(|s| s.id == id) {
+            let role = plan.roles.get(&s.of).map_or("plate", String::as_str);
+            let mut lines = vec![format!(
+                "{id}: the stretch of {role} {} across the joint of panels {}, u = {:.3} .. {:.3} m ({:.3} m, {:.1} kg): fixed on site once the panels stand, built in no panel",
+                s.of,
+                s.laps.join(" and "),
+                s.u_start,
+                s.u_end,
+                s.u_end - s.u_start,
+                s.mass
+            )];
+            lines.extend(lap_line(&wall.panels, &s.of, limits.cap_lap));
+            return Some(answer(id, "site_piece", wall, None, lines));
+        }
     }
     None
 }
 
-/// The breaks at which a piece (a cut plate) is cut: the panels' bounds inside its span.
-fn cuts_of(split: &WallPanels, plate: &str) -> Vec<f64> {
-    let mut cuts = vec![];
-    for p in &split.panels {
-        for c in p.cut_pieces.iter().filter(|c| c.of == plate) {
-            if (c.u_start - p.u_start).abs() < 1e-9 && p.index > 1 {
-                cuts.push(p.u_start);
-            }
-        }
+/// Why a plate stops short of the breaks, if it laps over them.
+fn lap_line(split: &WallPanels, plate: &str, lap: f64) -> Option<String> {
+    if !split.site_pieces.iter().any(|s| s.of == plate) {
+        return None;
     }
-    cuts
+    Some(format!(
+        "it laps over the panel joints: held back {lap:.3} m on both sides of each break (rules/panels.dl, cap_plate_laps; the cell's [panels] cap_lap), so its joints lie {lap:.3} m from the top plate's; a segment shorter than that is not made"
+    ))
+}
+
+/// The breaks at which a piece (a cut plate) is cut: the breaks inside its span (its
+/// segments' and site pieces' extent).
+fn cuts_of(split: &WallPanels, plate: &str) -> Vec<f64> {
+    let spans = split
+        .panels
+        .iter()
+        .flat_map(|p| &p.cut_pieces)
+        .filter(|c| c.of == plate)
+        .map(|c| (c.u_start, c.u_end))
+        .chain(
+            split
+                .site_pieces
+                .iter()
+                .filter(|s| s.of == plate)
+                .map(|s| (s.u_start, s.u_end)),
+        );
+    let (lo, hi) = spans.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (a, b)| {
+        (lo.min(a), hi.max(b))
+    });
+    split
+        .breaks
+        .iter()
+        .map(|b| b.u)
+        .filter(|&u| u > lo + TOLERANCE && u < hi - TOLERANCE)
+        .collect()
 }
 
 fn answer(

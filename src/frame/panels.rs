@@ -12,7 +12,11 @@
 //! Where no choice meets every limit, the mass limit is dropped, then the minimum length, and the
 //! wall's note says so; where no split exists at all the wall stays one panel and says why.
 //! Plates lying level (`cut_at_break`) are cut at the breaks into segments `PLATE~k` (k from 1
-//! along u); an end stud a break adds is `STUD~endK`, K the panel (from 1) it belongs to.
+//! along u: the k-th panel the plate runs through); an end stud a break adds is `STUD~endK`,
+//! K the panel (from 1) it belongs to. A plate that laps over the joints (`cut_lapped`, cap
+//! plates) is held back `lap` on both sides of each break: its segments stop `lap` short of
+//! the break (a segment shorter than `lap` is not made) and the stretch across the joint is a
+//! site piece `PLATE~lapK` (K the first break it spans along the plate), fixed on site.
 
 use super::plan::Wall;
 use crate::cell::PanelLimits;
@@ -35,6 +39,8 @@ pub struct PieceSpan<'a> {
     pub mass: f64,
     /// Cut at a break (a plate lying level) rather than kept whole.
     pub cut: bool,
+    /// How far a cut piece is held back from each break (0: cut at the break), m.
+    pub lap: f64,
 }
 
 /// What the rules say about one wall.
@@ -103,6 +109,19 @@ pub struct AddedPiece {
     pub mass: f64,
 }
 
+/// The stretch of a lapped plate across a panel joint: fixed on site, in no panel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SitePiece {
+    /// `PLATE~lapK`.
+    pub id: String,
+    pub of: String,
+    pub u_start: f64,
+    pub u_end: f64,
+    pub mass: f64,
+    /// The panels it laps over, along u.
+    pub laps: Vec<String>,
+}
+
 /// A break the split made.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PanelBreak {
@@ -116,6 +135,8 @@ pub struct PanelBreak {
 pub struct WallPanels {
     pub panels: Vec<Panel>,
     pub breaks: Vec<PanelBreak>,
+    /// Pieces fixed on site across the joints (lapped plates), along u.
+    pub site_pieces: Vec<SitePiece>,
     /// What the split could not do (limits dropped, wanted breaks not made).
     pub notes: Vec<String>,
 }
@@ -148,7 +169,7 @@ pub fn split_wall(
         vec![]
     };
     let cuts: Vec<f64> = chosen.iter().map(|&i| sites[i].u).collect();
-    let panels = build_panels(
+    let (panels, site_pieces) = build_panels(
         wall_id, length, pieces, breaks, &sites, &chosen, role_of, limits,
     );
     let count = panels.len();
@@ -167,6 +188,7 @@ pub fn split_wall(
     WallPanels {
         panels,
         breaks: reasons,
+        site_pieces,
         notes,
     }
 }
@@ -221,8 +243,8 @@ struct MassIndex {
     /// Whole pieces' centres along u, sorted, with the running mass up to each.
     centres: Vec<f64>,
     running: Vec<f64>,
-    /// Cut pieces: (u0, u1, mass).
-    cut: Vec<(f64, f64, f64)>,
+    /// Cut pieces: (u0, u1, mass, lap).
+    cut: Vec<(f64, f64, f64, f64)>,
     /// Per site: mass of the end studs it adds after it and before it.
     added_after: Vec<f64>,
     added_before: Vec<f64>,
@@ -262,21 +284,24 @@ impl MassIndex {
             cut: pieces
                 .iter()
                 .filter(|p| p.cut)
-                .map(|p| (p.u0, p.u1, p.mass))
+                .map(|p| (p.u0, p.u1, p.mass, p.lap))
                 .collect(),
             added_after: added(1),
             added_before: added(-1),
         }
     }
 
-    /// Mass of the pieces between `a` and `b` (whole pieces by their centre, cut ones by share).
-    fn between(&self, a: f64, b: f64) -> f64 {
+    /// Mass of the pieces between `a` and `b` (whole pieces by their centre, cut ones by share;
+    /// a lapped piece held back from `a` or `b` where that end is a break).
+    fn between(&self, a: f64, b: f64, a_break: bool, b_break: bool) -> f64 {
         let at = |u: f64| self.centres.partition_point(|c| *c < u);
         let whole = self.running[at(b)] - self.running[at(a)];
         let cut: f64 = self
             .cut
             .iter()
-            .map(|&(u0, u1, m)| {
+            .map(|&(u0, u1, m, lap)| {
+                let a = if a_break { a + lap } else { a };
+                let b = if b_break { b - lap } else { b };
                 let overlap = (b.min(u1) - a.max(u0)).max(0.0);
                 if u1 > u0 {
                     m * overlap / (u1 - u0)
@@ -311,7 +336,7 @@ fn choose(
     points.push(length);
     let n = points.len();
     let mass_of = |i: usize, j: usize| {
-        let mut m = mass.between(points[i], points[j]);
+        let mut m = mass.between(points[i], points[j], i > 0, j < n - 1);
         if i > 0 {
             m += mass.added_after[i - 1];
         }
@@ -477,7 +502,7 @@ fn build_panels(
     chosen: &[usize],
     role_of: &dyn Fn(&str) -> String,
     limits: &PanelLimits,
-) -> Vec<Panel> {
+) -> (Vec<Panel>, Vec<SitePiece>) {
     let mut bounds = vec![0.0];
     bounds.extend(chosen.iter().map(|&i| sites[i].u));
     bounds.push(length);
@@ -498,6 +523,7 @@ fn build_panels(
         .collect();
     let panel_at = |u: f64| bounds[1..count].partition_point(|b| *b <= u);
     let mut spans: Vec<Vec<(f64, f64)>> = vec![vec![]; count];
+    let mut site_pieces = vec![];
     for p in pieces {
         let inner: Vec<f64> = bounds[1..count]
             .iter()
@@ -514,18 +540,36 @@ fn build_panels(
         let mut ends = vec![p.u0];
         ends.extend(inner);
         ends.push(p.u1);
+        let share = |a: f64, b: f64| p.mass * (b - a) / (p.u1 - p.u0);
+        let last = ends.len() - 2;
+        // Where the plate is covered so far (the start of the next site piece).
+        let mut covered = p.u0;
+        // The first break the next site piece spans (breaks numbered from 1 along the plate).
+        let mut gap_from_break = 1;
         for (s, pair) in ends.windows(2).enumerate() {
             let k = panel_at((pair[0] + pair[1]) / 2.0);
-            let mass = p.mass * (pair[1] - pair[0]) / (p.u1 - p.u0);
+            let start = if s == 0 { pair[0] } else { pair[0] + p.lap };
+            let end = if s == last { pair[1] } else { pair[1] - p.lap };
+            if end - start < p.lap.max(TOLERANCE) {
+                continue;
+            }
+            if start > covered + 1e-9 {
+                site_pieces.push(site_piece(p, covered, start, gap_from_break, &panels));
+            }
             panels[k].cut_pieces.push(CutPiece {
                 id: format!("{}~{}", p.id, s + 1),
                 of: p.id.to_string(),
-                u_start: pair[0],
-                u_end: pair[1],
-                mass,
+                u_start: start,
+                u_end: end,
+                mass: share(start, end),
             });
-            panels[k].mass += mass;
+            panels[k].mass += share(start, end);
             spans[k].push((p.v0, p.v1));
+            covered = end;
+            gap_from_break = s + 1;
+        }
+        if covered < p.u1 - 1e-9 {
+            site_pieces.push(site_piece(p, covered, p.u1, gap_from_break, &panels));
         }
     }
     let by_id: FxHashMap<&str, &PieceSpan> = pieces.iter().map(|p| (p.id, p)).collect();
@@ -562,7 +606,31 @@ fn build_panels(
             .sort_by(|a, b| a.u_start.total_cmp(&b.u_start));
         panel.exceeds = exceeded(panel, limits, count > 1);
     }
-    panels
+    site_pieces.sort_by(|a, b| a.u_start.total_cmp(&b.u_start).then(a.id.cmp(&b.id)));
+    (panels, site_pieces)
+}
+
+/// The site piece of lapped plate `p` from `u_start` to `u_end` (`PLATE~lapK`, K the first
+/// break it spans, numbered from 1 along the plate).
+fn site_piece(
+    p: &PieceSpan,
+    u_start: f64,
+    u_end: f64,
+    first_break: usize,
+    panels: &[Panel],
+) -> SitePiece {
+    SitePiece {
+        id: format!("{}~lap{first_break}", p.id),
+        of: p.id.to_string(),
+        u_start,
+        u_end,
+        mass: p.mass * (u_end - u_start) / (p.u1 - p.u0),
+        laps: panels
+            .iter()
+            .filter(|k| k.u_start < u_end - TOLERANCE && k.u_end > u_start + TOLERANCE)
+            .map(|k| k.id.clone())
+            .collect(),
+    }
 }
 
 /// The limits a panel breaks, in words.
@@ -600,11 +668,18 @@ fn exceeded(panel: &Panel, limits: &PanelLimits, split: bool) -> Vec<String> {
 pub fn limits_from(relations: &Relations) -> Option<PanelLimits> {
     let t = relations.get("panel_limit")?.first()?;
     let f = |i: usize| t.get(i).and_then(Value::as_float).unwrap_or(f64::NAN);
+    let cap_lap = relations
+        .get("panel_cap_lap")
+        .and_then(|r| r.first())
+        .and_then(|t| t.first())
+        .and_then(Value::as_float)
+        .unwrap_or(0.0);
     Some(PanelLimits {
         max_length: f(0),
         max_height: f(1),
         max_mass: f(2),
         min_length: f(3),
+        cap_lap,
     })
 }
 
@@ -612,6 +687,8 @@ pub fn limits_from(relations: &Relations) -> Option<PanelLimits> {
 pub struct BreakIndex<'r> {
     boxes: FxHashMap<&'r str, [f64; 6]>,
     cut: FxHashSet<&'r str>,
+    /// Cut pieces that lap over the joints, and how far (`cut_lapped`).
+    lapped: FxHashMap<&'r str, f64>,
     by_wall: FxHashMap<&'r str, WallBreaks<'r>>,
     none: WallBreaks<'r>,
 }
@@ -632,6 +709,12 @@ impl<'r> BreakIndex<'r> {
             .map(|t| (sym(&t[0]), std::array::from_fn(|i| float(&t[i + 1]))))
             .collect();
         let cut = get("cut_at_break").iter().map(|t| sym(&t[0])).collect();
+        let mut lapped: FxHashMap<&str, f64> = FxHashMap::default();
+        for t in get("cut_lapped") {
+            // Two rules lapping one piece: the longer lap holds.
+            let lap = lapped.entry(sym(&t[0])).or_insert(0.0);
+            *lap = lap.max(float(&t[1]));
+        }
         let mut by_wall: FxHashMap<&str, WallBreaks> = FxHashMap::default();
         fn wall<'m, 'r>(
             by_wall: &'m mut FxHashMap<&'r str, WallBreaks<'r>>,
@@ -664,6 +747,7 @@ impl<'r> BreakIndex<'r> {
         BreakIndex {
             boxes,
             cut,
+            lapped,
             by_wall,
             none: WallBreaks::default(),
         }
@@ -688,6 +772,7 @@ impl<'r> BreakIndex<'r> {
                     v1: b[3],
                     mass: masses.get(id).copied().unwrap_or(0.0),
                     cut: self.cut.contains(id.as_str()),
+                    lap: self.lapped.get(id.as_str()).copied().unwrap_or(0.0),
                 }
             })
             .collect()
@@ -722,6 +807,7 @@ mod tests {
             max_height: 3.5,
             max_mass: 1000.0,
             min_length,
+            cap_lap: 0.61,
         }
     }
 
@@ -751,6 +837,7 @@ mod tests {
                 v1: 2.4,
                 mass: if i == 0 { length } else { 5.0 },
                 cut: i == 0,
+                lap: 0.0,
             })
             .collect();
         let breaks = WallBreaks {
@@ -818,5 +905,96 @@ mod tests {
         assert!(cuts(&w).contains(&2.0), "{:?}", cuts(&w));
         let w = split(10.0, &sites, &[2.1], &limits(7.5, 1.2));
         assert!(w.notes[0].contains("u = 2.100 m (shop) is not made"));
+    }
+
+    #[test]
+    fn a_lapped_plate_is_held_back_from_each_break_and_the_joint_is_a_site_piece() {
+        // 10 m: a top plate cut at the breaks and a cap plate lapping 0.6 m; sites every 0.4 m.
+        let sites: Vec<f64> = (1..25).map(|i| i as f64 * 0.4).collect();
+        let span = |id: &'static str, v0: f64, cut: bool, lap: f64| PieceSpan {
+            id,
+            u0: 0.0,
+            u1: 10.0,
+            v0,
+            v1: v0 + 0.038,
+            mass: 10.0,
+            cut,
+            lap,
+        };
+        let pieces = [span("top", 2.4, true, 0.0), span("cap", 2.438, true, 0.6)];
+        let breaks = WallBreaks {
+            split: true,
+            allowed: sites,
+            wanted: vec![(1.6, "shop")],
+            ..WallBreaks::default()
+        };
+        let w = split_wall("W", 10.0, &pieces, &breaks, &limits(7.5, 1.2), &|_| {
+            "stud".into()
+        });
+        // Breaks at 1.6 (wanted) and one more: the 1.6 m panel keeps a cap of 1.0 m.
+        assert_eq!(w.panels.len(), 3, "{:?}", w.breaks);
+        let (b1, b2) = (w.breaks[0].u, w.breaks[1].u);
+        assert_eq!(b1, 1.6);
+        let caps: Vec<&CutPiece> = w
+            .panels
+            .iter()
+            .flat_map(|p| &p.cut_pieces)
+            .filter(|c| c.of == "cap")
+            .collect();
+        let ends: Vec<(f64, f64)> = caps.iter().map(|c| (c.u_start, c.u_end)).collect();
+        let near = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        assert_eq!(ends.len(), 3);
+        assert!(near(ends[0].0, 0.0) && near(ends[0].1, b1 - 0.6));
+        assert!(near(ends[1].0, b1 + 0.6) && near(ends[1].1, b2 - 0.6));
+        assert!(near(ends[2].0, b2 + 0.6) && near(ends[2].1, 10.0));
+        // The joints: one site piece per break, 1.2 m long, lapping the panels on both sides.
+        assert_eq!(w.site_pieces.len(), 2);
+        assert_eq!(w.site_pieces[0].id, "cap~lap1");
+        assert_eq!(w.site_pieces[0].laps, ["W-P1", "W-P2"]);
+        assert!(near(w.site_pieces[1].u_start, b2 - 0.6) && near(w.site_pieces[1].u_end, b2 + 0.6));
+        // The cap is covered exactly once; its mass is shared by length.
+        let mass: f64 = caps.iter().map(|c| c.mass).sum::<f64>()
+            + w.site_pieces.iter().map(|s| s.mass).sum::<f64>();
+        assert!(near(mass, 10.0));
+        // The top plate is cut at the breaks.
+        let tops: Vec<&CutPiece> = w
+            .panels
+            .iter()
+            .flat_map(|p| &p.cut_pieces)
+            .filter(|c| c.of == "top")
+            .collect();
+        assert!(near(tops[0].u_end, b1) && near(tops[1].u_start, b1));
+    }
+
+    #[test]
+    fn a_panel_too_short_for_its_cap_gives_it_to_the_site_piece() {
+        let span = |id: &'static str, lap: f64| PieceSpan {
+            id,
+            u0: 0.0,
+            u1: 9.0,
+            v0: 2.4,
+            v1: 2.438,
+            mass: 9.0,
+            cut: true,
+            lap,
+        };
+        let pieces = [span("cap", 1.0)];
+        // Wanted breaks 4.0 and 5.5: the middle panel (1.5 m) would keep 1.5 − 2 × 1.0 < 1.0.
+        let breaks = WallBreaks {
+            split: true,
+            allowed: vec![4.0, 5.5],
+            wanted: vec![(4.0, "shop"), (5.5, "shop")],
+            ..WallBreaks::default()
+        };
+        let w = split_wall("W", 9.0, &pieces, &breaks, &limits(7.5, 1.2), &|_| {
+            "".into()
+        });
+        assert_eq!(w.panels.len(), 3);
+        assert!(w.panels[1].cut_pieces.is_empty());
+        assert_eq!(w.site_pieces.len(), 1);
+        let s = &w.site_pieces[0];
+        assert_eq!(s.id, "cap~lap1");
+        assert!((s.u_start - 3.0).abs() < 1e-9 && (s.u_end - 6.5).abs() < 1e-9);
+        assert_eq!(s.laps, ["W-P1", "W-P2", "W-P3"]);
     }
 }

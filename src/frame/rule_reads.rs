@@ -24,6 +24,8 @@ pub const PLAN: &[&str] = &[
     "wall_split",
     "local_box",
     "cut_at_break",
+    "panel_cap_lap",
+    "cut_lapped",
     "break_allowed",
     "break_added",
     "break_wanted",

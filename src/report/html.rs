@@ -309,7 +309,6 @@ fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
     }
 }
 
-/// The wall's panels, when it is split: one row each.
 /// Where a panel of a split wall lies in its wall, and the wall's other panels.
 fn panels(w: &WallView) -> Markup {
     let split = w.panels;
@@ -333,6 +332,9 @@ fn panels(w: &WallView) -> Markup {
                         td { (if p.exceeds.is_empty() { "-".to_string() } else { p.exceeds.join(", ") }) }
                     }
                 }
+            }
+            @if !split.site_pieces.is_empty() {
+                p { (format!("Fixed on site, in no panel: {} stretches of lapped plates across the joints (a cap plate is held back from each break, so its joints lie clear of the top plate's): {}.", split.site_pieces.len(), split.site_pieces.iter().map(|s| format!("{} (u {:.3} to {:.3} m, over {})", s.id, s.u_start, s.u_end, s.laps.join(" and "))).collect::<Vec<_>>().join("; "))) }
             }
             @for note in &split.notes { p class="note" { (note) } }
         }

@@ -17,6 +17,8 @@ pub struct LimitsRow {
     pub max_height: f64,
     pub max_mass: f64,
     pub min_length: f64,
+    /// How far cap plates are held back from each break (0: cut at the break).
+    pub cap_lap: f64,
 }
 
 impl LimitsRow {
@@ -26,6 +28,7 @@ impl LimitsRow {
             max_height: round_m(l.max_height),
             max_mass: round_kg(l.max_mass),
             min_length: round_m(l.min_length),
+            cap_lap: round_m(l.cap_lap),
         }
     }
 }
@@ -65,6 +68,19 @@ pub struct AddedRow<'a> {
     pub u_start: f64,
     pub u_end: f64,
     pub mass: f64,
+}
+
+/// A stretch of a lapped plate across a joint, fixed on site.
+#[derive(Debug, Serialize)]
+pub struct SiteRow<'a> {
+    pub id: &'a str,
+    pub of: &'a str,
+    pub u_start: f64,
+    pub u_end: f64,
+    pub length: f64,
+    pub mass: f64,
+    /// The panels it laps over.
+    pub laps: &'a [String],
 }
 
 #[derive(Debug, Serialize)]
@@ -115,6 +131,22 @@ pub fn panel_rows(split: &WallPanels) -> Vec<PanelRow<'_>> {
         .collect()
 }
 
+pub fn site_rows(split: &WallPanels) -> Vec<SiteRow<'_>> {
+    split
+        .site_pieces
+        .iter()
+        .map(|s| SiteRow {
+            id: &s.id,
+            of: &s.of,
+            u_start: round_m(s.u_start),
+            u_end: round_m(s.u_end),
+            length: round_m(s.u_end - s.u_start),
+            mass: round_kg(s.mass),
+            laps: &s.laps,
+        })
+        .collect()
+}
+
 pub fn break_rows(split: &WallPanels) -> Vec<BreakRow<'_>> {
     split
         .breaks
@@ -137,8 +169,13 @@ pub fn text_line(split: &WallPanels) -> Option<String> {
         .map(|p| format!("{:.2}", p.length()))
         .collect();
     let at: Vec<String> = split.breaks.iter().map(|b| format!("{:.3}", b.u)).collect();
+    let site = match split.site_pieces.len() {
+        0 => String::new(),
+        1 => "; 1 piece laps a joint on site".to_string(),
+        n => format!("; {n} pieces lap the joints on site"),
+    };
     Some(format!(
-        "  {} panels of {} m, split at u = {} m",
+        "  {} panels of {} m, split at u = {} m{site}",
         split.panels.len(),
         lengths.join(", "),
         at.join(", ")

@@ -1,7 +1,9 @@
 //! The `plan` report (DESIGN §8): members with wall and role, walls with
 //! frame, assembly order, precedence, nailing and framing targets.
 
-use super::panels::{BreakRow, LimitsRow, PanelRow, break_rows, panel_rows, text_line};
+use super::panels::{
+    BreakRow, LimitsRow, PanelRow, SiteRow, break_rows, panel_rows, site_rows, text_line,
+};
 use super::{round_m, round_point};
 use crate::frame::plan::Plan;
 use crate::ifc::{LengthUnit, Model};
@@ -66,6 +68,8 @@ pub struct WallRow<'a> {
     /// The wall split into panels the cell builds (one when it fits).
     pub panels: Vec<PanelRow<'a>>,
     pub panel_breaks: Vec<BreakRow<'a>>,
+    /// Stretches of lapped plates (cap plates) across the panel joints, fixed on site.
+    pub site_pieces: Vec<SiteRow<'a>>,
     /// The text report's line on the panels (split walls only).
     #[serde(skip)]
     pub panels_line: Option<String>,
@@ -255,6 +259,7 @@ impl<'a> PlanReport<'a> {
                         .collect(),
                     panels: panel_rows(&w.panels),
                     panel_breaks: break_rows(&w.panels),
+                    site_pieces: site_rows(&w.panels),
                     panels_line: text_line(&w.panels),
                 }
             })

@@ -166,6 +166,8 @@ outputs! {
     "wall_split" => r_wall_split(0);
     "local_box" => r_local_box(0, 1, 2, 3, 4, 5, 6);
     "cut_at_break" => r_cut_at_break(0);
+    "panel_cap_lap" => r_panel_cap_lap(0);
+    "cut_lapped" => r_cut_lapped(0, 1);
     "break_allowed" => r_break_allowed(0, 1);
     "break_added" => r_break_added(0, 1, 2, 3);
     "break_wanted" => r_break_wanted(0, 1, 2);
