@@ -162,7 +162,13 @@ fn a_long_wall_is_simulated_panel_by_panel_and_an_edit_redoes_one_panel() {
         .iter()
         .find(|e| e["framing"]["status"] == "failed" && !e["id"].as_str().unwrap().contains('~'))
         .expect("a modelled piece fails on this cell");
-    let why = framewright(&["why", m, failed["id"].as_str().unwrap(), "--no-cache"]);
+    let why = framewright(&[
+        "why",
+        m,
+        failed["id"].as_str().unwrap(),
+        "--no-cache",
+        "--verbose",
+    ]);
     assert!(
         why.status.success(),
         "{}",

@@ -1,6 +1,8 @@
 //! `framewright why` and `why-not` on the command line: JSON structure, key
 //! text lines, byte-identical output run to run, and bad ids / tuples (exit 2).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -120,6 +122,7 @@ fn why_text_names_the_element_rules_and_sources() {
         m.to_str().unwrap(),
         "32H5oapRpM57uELNCcVku8",
         "--no-simulate",
+        "--verbose",
     ]);
     assert_eq!(
         text.lines().next().unwrap(),
@@ -154,6 +157,7 @@ fn why_explains_user_findings() {
         "--rules",
         rules.to_str().unwrap(),
         "--no-simulate",
+        "--verbose",
     ]);
     let first = text.lines().nth(3).unwrap();
     assert!(first.starts_with("violation(\"1SLgxFv2F86AyYIFLQqMY1\", \"shorter_than_gripper_spacing\", \"member is 60 mm long, shorter than the gripper spacing (600 mm): both grippers cannot hold it\")  [by shorter_than_gripper_spacing ("), "{first}");
@@ -282,10 +286,53 @@ fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
         "--cache-dir",
         cache.path().to_str().unwrap(),
     ];
+    let answer = ok(&args);
+    let args = [&args[..], &["--verbose"]].concat();
     let first = ok(&args);
     assert!(
-        first.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"),
-        "{first}"
+        answer.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n")
+            && first.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ (from the cache)\n"),
+        "{answer}"
+    );
+    // The answer first: the cause with its numbers, the nails it cost folded, under 30 lines.
+    let lines: Vec<&str> = answer.lines().collect();
+    assert!(lines.len() < 30, "{answer}");
+    assert!(
+        lines[4].starts_with(
+            "framing failed (Robot): place pose beyond reach: the wrist centre would be "
+        ),
+        "{answer}"
+    );
+    assert!(lines[4].contains(" m from the shoulder, the arm reaches 2.377 m ("));
+    // Its nails, from the plan: every nailing target with the top plate as plate or member.
+    let plan: serde_json::Value = serde_json::from_str(&ok(&[
+        "plan",
+        m.to_str().unwrap(),
+        "--offset-x",
+        "0.531",
+        "--json",
+    ]))
+    .unwrap();
+    let id = "32H5oapRpM57uELNCcVku8";
+    let nails = plan["walls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|w| w["nailing_targets"].as_array().unwrap())
+        .filter(|t| t["plate"] == id || t["member"] == id)
+        .count();
+    assert!(
+        lines[2] == format!("framing: failed; nailing: failed (0 of {nails} nails driven)"),
+        "{answer}"
+    );
+    let folded: usize = lines
+        .iter()
+        .filter_map(|l| l.strip_prefix("  so "))
+        .map(|l| l.split(' ').next().unwrap().parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(folded, nails, "{answer}");
+    assert!(
+        answer.contains("nails not driven because it was not placed: 32H5oapRpM57uELNCcVku8 -> ")
     );
     let reason = first.lines().nth(3).unwrap();
     assert!(reason.starts_with("element_reason(\"32H5oapRpM57uELNCcVku8\", \"framing\", \"Robot\", \"place pose beyond reach: the wrist centre would be "), "{reason}");
@@ -322,11 +369,33 @@ fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
         first.contains("element_framing(\"32H5oapRpM57uELNCcVku8\", \"failed\")"),
         "{first}"
     );
-    let second = ok(&args);
-    assert!(second.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ (from the cache)\n"));
+    // The same answer in JSON: the cause, and its consequences with every nail.
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&[&args[..args.len() - 1], &["--json"]].concat())).unwrap();
+    let a = &json["elements"][0]["answer"];
+    assert_eq!(
+        a["causes"][0]["rule"].as_str().unwrap().split(' ').next(),
+        Some("framing_place_beyond_reach")
+    );
+    let counted: u64 = a["causes"][0]["consequences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            assert_eq!(
+                c["ids"].as_array().unwrap().len() as u64,
+                c["count"].as_u64().unwrap()
+            );
+            c["count"].as_u64().unwrap()
+        })
+        .sum();
+    assert_eq!(counted as usize, nails);
+    // Afresh, it says the same as from the cache.
+    let fresh = ok(&[&args[..args.len() - 3], &["--no-cache", "--verbose"]].concat());
+    assert!(fresh.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"));
     assert_eq!(
         first.lines().skip(1).collect::<Vec<_>>(),
-        second.lines().skip(1).collect::<Vec<_>>()
+        fresh.lines().skip(1).collect::<Vec<_>>()
     );
     let json = ok(&[&args[..], &["--json"]].concat());
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
@@ -420,4 +489,47 @@ fn a_contact_tolerance_the_simulation_would_not_use_is_refused() {
         "--no-simulate",
     ]);
     assert!(plan_only.contains("32H5oapRpM57uELNCcVku8"), "{plan_only}");
+}
+
+#[test]
+fn why_answers_first_on_a_real_wall() {
+    // A bottom plate of the Constructivity wall whose place pose collides with the touch sensor
+    // on the study cell: the cause first, its nails in one line, the whole answer short.
+    let Some(model) =
+        common::shared_path("ifc-realworld/timber_constructivity_wall-elemented-case_IFC4.ifc")
+    else {
+        return;
+    };
+    let text = ok(&[
+        "why",
+        model.to_str().unwrap(),
+        "3E4igxyD1F5w4vj3LTAREz/0",
+        "--no-cache",
+    ]);
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines.len() < 30, "{text}");
+    let cause = lines
+        .iter()
+        .position(|l| l.starts_with("framing failed ("))
+        .expect("a cause");
+    assert!(cause < 10, "{text}");
+    // Every nail of the piece is in the folded lines, and each kind is one line.
+    let planned = lines[2]
+        .split(" (")
+        .nth(1)
+        .and_then(|r| r.split(" of ").nth(1))
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse::<usize>().ok())
+        .expect("nails planned");
+    let folded: usize = lines
+        .iter()
+        .filter_map(|l| l.trim_start().strip_prefix("so "))
+        .map(|l| l.split(' ').next().unwrap().parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(folded, planned, "{text}");
+    assert_eq!(
+        text.matches("was not placed\")").count(),
+        0,
+        "no nail's tree: {text}"
+    );
 }

@@ -12,7 +12,7 @@ use framewright::frame::placement::{add_placement_facts, reason_placed};
 use framewright::frame::plan::Plan;
 use framewright::logic::compiled::Relations;
 use framewright::sim::{prepare_facts, whole_facts};
-use framewright::user_rules::render::{render_why, render_why_not};
+use framewright::user_rules::render::{render_answer, render_why, render_why_not};
 use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
 use framewright::user_rules::why::{
     Context, WhyError, element_walls_split, resolve_element, why, why_not,
@@ -28,6 +28,9 @@ pub struct WhyArgs {
     /// A piece id, an IFC GlobalId or an entity `#id`; or a panel (`W1-P2`), a plate segment
     /// (`PLATE~2`), an added end stud (`STUD~end2`) or a site piece (`CAP~lap1`) of the plan.
     pub id: String,
+    /// Print every verdict's derivation tree, not only the answer and its causes' trees.
+    #[arg(long, alias = "tree")]
+    pub verbose: bool,
     #[command(flatten)]
     pub common: Common,
 }
@@ -237,7 +240,11 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         if c.no_simulate {
             text.push_str("not simulated (--no-simulate): plan verdicts only\n");
         }
-        text.push_str(&render_why(&reports));
+        text.push_str(&if args.verbose {
+            render_why(&reports)
+        } else {
+            render_answer(&reports)
+        });
         text
     };
     print_stdout(&text)

@@ -2,7 +2,10 @@
 //! the widest supporting facts first (the premise resting on the most facts),
 //! numbers shortened, a fact already shown printed once, and long runs of
 //! input facts of one relation folded with a count. `--json` has everything.
+//! By default `why` prints the answer first (`render_answer`): each failure's cause with its
+//! numbers and what it led to, then only the causes' trees; `--verbose` prints every tree.
 
+use super::answer::fold_ids;
 use super::why::{Verdict, WhyNotNode, WhyNotReport, WhyReport};
 use crate::logic::provenance::{Explanation, How, Premise};
 use crate::logic::{Origin, Value};
@@ -13,43 +16,135 @@ use std::fmt::Write as _;
 const FOLD_AFTER: usize = 3;
 /// Levels of a tree shown on a terminal; deeper facts are counted.
 const MAX_DEPTH: usize = 6;
+/// Levels of a cause's tree under the answer (the rest: `--verbose`).
+const ANSWER_DEPTH: usize = 3;
+/// Nail pairs listed in a consequence's line (all of them: `--json`).
+const PAIRS_SHOWN: usize = 4;
 /// Conditions longer than this (aggregates over boxes) are cut.
 const MAX_CONDITION: usize = 160;
 
+/// The element's line: id, name, type, entity, GlobalId, wall.
+fn element_line(s: &mut String, r: &WhyReport) {
+    let e = &r.element;
+    let name = e.name.as_deref().unwrap_or("");
+    let _ = writeln!(
+        s,
+        "{} '{name}' ({} #{}, GlobalId {}){}",
+        e.id,
+        e.ifc_type,
+        e.entity,
+        e.global_id,
+        r.wall
+            .as_ref()
+            .map_or(String::from(", in no wall"), |w| format!(", wall {w}"))
+    );
+}
+
+/// The answer first: statuses, each cause with its numbers and what it led to, findings, the
+/// plan's verdicts; then the tree of each cause.
+pub fn render_answer(reports: &[WhyReport]) -> String {
+    let mut s = String::new();
+    for (k, r) in reports.iter().enumerate() {
+        if k > 0 {
+            s.push('\n');
+        }
+        element_line(&mut s, r);
+        let a = &r.answer;
+        if r.verdicts.is_empty() {
+            s.push_str("  no verdicts: the rules derived nothing about this piece\n");
+            continue;
+        }
+        let statuses: Vec<String> = a
+            .statuses
+            .iter()
+            .map(|st| match st.nails {
+                Some((done, of)) => {
+                    format!("{}: {} ({done} of {of} nails driven)", st.stage, st.status)
+                }
+                None => format!("{}: {}", st.stage, st.status),
+            })
+            .collect();
+        if !statuses.is_empty() {
+            let _ = writeln!(s, "{}", statuses.join("; "));
+        }
+        for c in &a.causes {
+            s.push('\n');
+            let what = match c.subjects.len() {
+                0 => String::new(),
+                1 => format!("nail {}: ", c.subjects[0]),
+                n => format!("{n} nails ({}), the first: ", fold_ids(&c.subjects)),
+            };
+            let _ = writeln!(
+                s,
+                "{} failed ({}): {what}{}",
+                c.stage, c.component, c.message
+            );
+            let _ = writeln!(s, "  by {}", c.rule);
+            for q in &c.consequences {
+                let _ = writeln!(s, "  so {} {}: {}", q.count, q.kind, pairs(&q.ids));
+            }
+        }
+        if !a.consequences.is_empty() || !a.findings.is_empty() {
+            s.push('\n');
+        }
+        for q in &a.consequences {
+            let _ = writeln!(s, "{} {}: {}", q.count, q.kind, pairs(&q.ids));
+        }
+        for f in &a.findings {
+            let _ = writeln!(s, "{f}");
+        }
+        if !a.plan.is_empty() {
+            let _ = writeln!(s, "plan: {}", a.plan.join("; "));
+        }
+        let trees: Vec<&Verdict> = a.causes.iter().map(|c| &r.verdicts[c.verdict]).collect();
+        if !trees.is_empty() {
+            s.push_str("\nhow each cause was derived:\n");
+        }
+        for v in trees {
+            render_verdict(&mut s, v, ANSWER_DEPTH);
+        }
+    }
+    s.push_str("\n(every verdict's derivation: --verbose; the whole trees: --json)\n");
+    s
+}
+
+/// Nails folded by pair, the first `PAIRS_SHOWN` pairs.
+fn pairs(ids: &[String]) -> String {
+    let all = fold_ids(ids);
+    let groups: Vec<&str> = all.split("; ").collect();
+    if groups.len() <= PAIRS_SHOWN {
+        return all;
+    }
+    format!(
+        "{}; and {} more pairs (--json lists them)",
+        groups[..PAIRS_SHOWN].join("; "),
+        groups.len() - PAIRS_SHOWN
+    )
+}
+
+/// Every verdict's tree (`--verbose`).
 pub fn render_why(reports: &[WhyReport]) -> String {
     let mut s = String::new();
     for (k, r) in reports.iter().enumerate() {
         if k > 0 {
             s.push('\n');
         }
-        let e = &r.element;
-        let name = e.name.as_deref().unwrap_or("");
-        let _ = writeln!(
-            s,
-            "{} '{name}' ({} #{}, GlobalId {}){}",
-            e.id,
-            e.ifc_type,
-            e.entity,
-            e.global_id,
-            r.wall
-                .as_ref()
-                .map_or(String::from(", in no wall"), |w| format!(", wall {w}"))
-        );
+        element_line(&mut s, r);
         if r.verdicts.is_empty() {
             s.push_str("  no verdicts: the rules derived nothing about this piece\n");
         }
         for v in &r.verdicts {
             s.push('\n');
-            render_verdict(&mut s, v);
+            render_verdict(&mut s, v, MAX_DEPTH);
         }
     }
     s
 }
 
-fn render_verdict(s: &mut String, v: &Verdict) {
+fn render_verdict(s: &mut String, v: &Verdict, max_depth: usize) {
     // Each verdict's tree stands on its own: a fact repeats across verdicts.
     let mut shown = BTreeSet::new();
-    render_node(s, &v.explanation, "", "", 0, &mut shown);
+    render_node(s, &v.explanation, "", "", (0, max_depth), &mut shown);
     let src = &v.sources;
     let entities: Vec<String> = src.ifc_entities.iter().map(|n| format!("#{n}")).collect();
     let _ = writeln!(
@@ -80,7 +175,7 @@ fn render_verdict(s: &mut String, v: &Verdict) {
     );
 }
 
-fn fact(e: &Explanation) -> String {
+pub(super) fn fact(e: &Explanation) -> String {
     let args: Vec<String> = e.tuple.iter().map(short_value).collect();
     format!("{}({})", e.relation, args.join(", "))
 }
@@ -101,7 +196,7 @@ fn size(e: &Explanation) -> usize {
     }
 }
 
-fn origin_text(relation: &str, tuple: &[Value], origin: &Origin) -> String {
+pub(super) fn origin_text(relation: &str, tuple: &[Value], origin: &Origin) -> String {
     match origin {
         Origin::Entity(n) => format!("IFC #{n}"),
         Origin::File { file, line: 0 } if relation.starts_with("cell_") => {
@@ -119,7 +214,7 @@ fn render_node(
     e: &Explanation,
     first: &str,
     rest: &str,
-    depth: usize,
+    (depth, max_depth): (usize, usize),
     shown: &mut BTreeSet<String>,
 ) {
     let head = fact(e);
@@ -140,7 +235,7 @@ fn render_node(
                 return;
             }
             let _ = writeln!(s, "{first}{head}  [by {rule}]");
-            if depth + 1 >= MAX_DEPTH && !premises.is_empty() {
+            if depth + 1 >= max_depth && !premises.is_empty() {
                 let below = size(e) - 1;
                 let _ = writeln!(
                     s,
@@ -154,7 +249,7 @@ fn render_node(
                 let last = i + 1 == lines.len();
                 let (f, r) = crate::logic::provenance::tree_branch(rest, last);
                 match line {
-                    Child::Node(t) => render_node(s, t, &f, &r, depth + 1, shown),
+                    Child::Node(t) => render_node(s, t, &f, &r, (depth + 1, max_depth), shown),
                     Child::Text(t) => {
                         let _ = writeln!(s, "{f}{t}");
                     }
@@ -238,7 +333,7 @@ pub fn render_why_not(query: &str, report: &WhyNotReport) -> String {
         WhyNotReport::Holds { explanation } => {
             let _ = writeln!(s, "{query} holds:");
             let mut shown = BTreeSet::new();
-            render_node(&mut s, explanation, "", "", 0, &mut shown);
+            render_node(&mut s, explanation, "", "", (0, MAX_DEPTH), &mut shown);
         }
         WhyNotReport::NotDerived { tree } => render_why_not_node(&mut s, tree, ""),
     }

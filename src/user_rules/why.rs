@@ -5,6 +5,7 @@
 //! explained down to its input facts: IFC entities, cell keys, simulation
 //! events.
 
+use super::answer::{Answer, answer};
 use super::{UserRulesError, full_program};
 use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::{Facts, RuleEngine};
@@ -235,6 +236,8 @@ pub struct WhyReport {
     pub element: ElementInfo,
     /// The element's wall, when it is in one.
     pub wall: Option<String>,
+    /// The answer first: causes with their numbers, consequences folded (`answer::answer`).
+    pub answer: Answer,
     pub verdicts: Vec<Verdict>,
 }
 
@@ -275,11 +278,14 @@ pub fn why_piece(engine: &Engine, piece: &Piece) -> Result<WhyReport, WhyError> 
             });
         }
     }
-    Ok(WhyReport {
+    let mut report = WhyReport {
         element: ElementInfo::of(piece),
         wall,
+        answer: Answer::default(),
         verdicts,
-    })
+    };
+    report.answer = answer(&report);
+    Ok(report)
 }
 
 /// Rules, IFC entities, cell keys and simulation facts a tree rests on.

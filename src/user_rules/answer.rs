@@ -1,0 +1,331 @@
+//! The answer `why` gives first, built from an element's verdicts: each failure's cause (the
+//! rule's message, which carries the numbers, and the simulation facts it rests on), what the
+//! cause led to folded into one line per kind ("6 nails not driven because it was not placed:
+//! …"), the element's statuses and the plan's verdicts in a line. The derivation trees stay in
+//! the report (`--verbose`, `--json`).
+
+use super::why::{Verdict, WhyReport};
+use crate::logic::Value;
+use crate::logic::provenance::{Explanation, How, Premise};
+use serde::Serialize;
+use std::collections::BTreeSet;
+
+/// Simulation facts shown under a cause at most.
+const EVIDENCE: usize = 3;
+
+/// The answer for one element.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Answer {
+    /// `framing: failed`, `nailing: failed (0 of 6 nails driven)`, …
+    pub statuses: Vec<Status>,
+    /// The failures' causes, framing first.
+    pub causes: Vec<Cause>,
+    /// Nails not driven because of another piece's failure (nailing reasons of the `Framing`
+    /// component that no cause of this element explains), folded per kind.
+    pub consequences: Vec<Consequence>,
+    /// Findings of the rules (warnings, user rules' violations), one message each.
+    pub findings: Vec<String>,
+    /// What the plan decided, in words (`role bottom_plate`, `assembly rank 3`).
+    pub plan: Vec<String>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Status {
+    pub stage: String,
+    pub status: String,
+    /// Nails driven and planned, for nailing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nails: Option<(i64, i64)>,
+}
+
+/// One cause of a failure: the rule's message with its numbers, the facts it rests on.
+#[derive(Clone, Debug, Serialize)]
+pub struct Cause {
+    pub stage: String,
+    pub component: String,
+    /// The rule's message; for nails folded together, the first one's, with `subjects`.
+    pub message: String,
+    /// The rule that derived it, `name (file:line)`.
+    pub rule: String,
+    /// The nails it is about (`PLATE -> MEMBER #k`), when it is about nails.
+    pub subjects: Vec<String>,
+    /// The simulation facts it rests on, as `fact  [origin]`.
+    pub evidence: Vec<String>,
+    /// What it led to, one entry per kind.
+    pub consequences: Vec<Consequence>,
+    /// The verdict (index into the report's `verdicts`) whose tree explains it.
+    pub verdict: usize,
+}
+
+/// Verdicts that follow from a cause, folded.
+#[derive(Clone, Debug, Serialize)]
+pub struct Consequence {
+    /// `nails not driven because it was not placed`.
+    pub kind: String,
+    pub count: usize,
+    /// `PLATE -> MEMBER #k` of each.
+    pub ids: Vec<String>,
+}
+
+/// A nail's reason split into the nail it names and what it says of it.
+struct NailReason<'a> {
+    subject: String,
+    cause: &'a str,
+}
+
+/// `nail PLATE -> MEMBER #k: cause` or `nail PLATE -> MEMBER #k cause`.
+fn nail_reason(message: &str) -> Option<NailReason<'_>> {
+    let rest = message.strip_prefix("nail ")?;
+    let hash = rest.find(" #")?;
+    let digits = rest[hash + 2..]
+        .find(|c: char| !c.is_ascii_digit())
+        .map_or(rest.len(), |i| hash + 2 + i);
+    let subject = rest[..digits].to_string();
+    let cause = rest[digits..].trim_start_matches(':').trim_start();
+    Some(NailReason { subject, cause })
+}
+
+/// A nail's cause with this element's id as "it" and the other piece's as "the other piece".
+fn in_words(n: &NailReason, id: &str) -> String {
+    let (pair, _) = n.subject.rsplit_once(" #").unwrap_or((&n.subject, ""));
+    let (plate, member) = pair.split_once(" -> ").unwrap_or((pair, ""));
+    let other = if plate == id { member } else { plate };
+    let mut text = n.cause.replace(id, "it");
+    if !other.is_empty() && other != id {
+        text = text.replace(other, "the other piece");
+    }
+    text
+}
+
+fn sym(t: &[Value], i: usize) -> &str {
+    t.get(i).and_then(Value::as_symbol).unwrap_or("")
+}
+
+fn rule_of(e: &Explanation) -> String {
+    match &e.how {
+        How::Rule { rule, .. } => rule.clone(),
+        _ => String::new(),
+    }
+}
+
+/// The simulation facts (inputs with a simulation origin) a tree rests on, first seen first.
+fn evidence(e: &Explanation, out: &mut Vec<String>, seen: &mut BTreeSet<String>) {
+    match &e.how {
+        How::Input { origin } if matches!(origin, crate::logic::Origin::Event(_)) => {
+            let line = format!(
+                "{}  [{}]",
+                super::render::fact(e),
+                super::render::origin_text(&e.relation, &e.tuple, origin)
+            );
+            if seen.insert(line.clone()) {
+                out.push(line);
+            }
+        }
+        How::Rule { premises, .. } => {
+            for p in premises {
+                if let Premise::Tuple(t) = p {
+                    evidence(t, out, seen);
+                }
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The first tuple of `relation` in a tree.
+fn find<'e>(e: &'e Explanation, relation: &str) -> Option<&'e Explanation> {
+    if e.relation == relation {
+        return Some(e);
+    }
+    if let How::Rule { premises, .. } = &e.how {
+        for p in premises {
+            if let Premise::Tuple(t) = p
+                && let Some(f) = find(t, relation)
+            {
+                return Some(f);
+            }
+        }
+    }
+    None
+}
+
+/// Builds the answer from a report's verdicts.
+pub fn answer(report: &WhyReport) -> Answer {
+    let id = report.element.id.as_str();
+    let mut out = Answer::default();
+    // Causes keyed by (stage, component, rule): nails of one rule fold into one.
+    let mut causes: Vec<Cause> = Vec::new();
+    // Nails not driven because a piece was not framed, by kind.
+    let mut skipped: Vec<Consequence> = Vec::new();
+    for (i, v) in report.verdicts.iter().enumerate() {
+        let t = &v.tuple;
+        match v.relation.as_str() {
+            "element_reason" => {
+                let (stage, component, message) = (sym(t, 1), sym(t, 2), sym(t, 3));
+                let rule = rule_of(&v.explanation);
+                let nail = nail_reason(message);
+                if let Some(n) = &nail
+                    && stage == "nailing"
+                    && component == "Framing"
+                {
+                    let kind = format!("nails not driven because {}", in_words(n, id));
+                    match skipped.iter_mut().find(|c| c.kind == kind) {
+                        Some(c) => {
+                            c.count += 1;
+                            c.ids.push(n.subject.clone());
+                        }
+                        None => skipped.push(Consequence {
+                            kind,
+                            count: 1,
+                            ids: vec![n.subject.clone()],
+                        }),
+                    }
+                    continue;
+                }
+                let same = causes.iter_mut().find(|c| {
+                    nail.is_some()
+                        && !c.subjects.is_empty()
+                        && c.stage == stage
+                        && c.component == component
+                        && c.rule == rule
+                });
+                match (same, nail) {
+                    (Some(c), Some(n)) => c.subjects.push(n.subject),
+                    (_, nail) => causes.push(cause(v, i, stage, component, message, rule, nail)),
+                }
+            }
+            "element_framing" | "element_nailing" => {
+                let nails = find(&v.explanation, "element_nail_count").map(|c| {
+                    let n = |k: usize| c.tuple.get(k).and_then(Value::as_number).unwrap_or(0);
+                    (n(2), n(1))
+                });
+                out.statuses.push(Status {
+                    stage: v.relation.trim_start_matches("element_").to_string(),
+                    status: sym(t, 1).to_string(),
+                    nails: nails.filter(|_| v.relation == "element_nailing"),
+                });
+            }
+            "role" => out.plan.push(format!("role {}", sym(t, 1))),
+            "assembly_rank" => out.plan.push(format!(
+                "assembly rank {}",
+                t.get(1).map_or(String::new(), |r| r.to_string())
+            )),
+            "violation" | "warning" | "frame_warning" | "world_warning" => {
+                let message = t.iter().rev().find_map(Value::as_symbol).unwrap_or("");
+                out.findings.push(format!(
+                    "{} ({}): {message}",
+                    v.relation,
+                    rule_of(&v.explanation)
+                ));
+            }
+            _ => {}
+        }
+    }
+    // What this element's own framing failure led to goes under that cause; what another
+    // piece's failure led to stands apart.
+    for consequence in skipped {
+        let own = consequence.kind.contains(" it ");
+        match causes.iter_mut().find(|c| c.stage == "framing") {
+            Some(c) if own => c.consequences.push(consequence),
+            _ => out.consequences.push(consequence),
+        }
+    }
+    // Framing causes first: a piece not placed explains its nails.
+    causes.sort_by_key(|c| c.stage != "framing");
+    out.causes = causes;
+    out
+}
+
+fn cause(
+    v: &Verdict,
+    index: usize,
+    stage: &str,
+    component: &str,
+    message: &str,
+    rule: String,
+    nail: Option<NailReason>,
+) -> Cause {
+    let mut lines = Vec::new();
+    evidence(&v.explanation, &mut lines, &mut BTreeSet::new());
+    lines.truncate(EVIDENCE);
+    Cause {
+        stage: stage.to_string(),
+        component: component.to_string(),
+        message: nail
+            .as_ref()
+            .map_or(message, |n| n.cause)
+            .trim()
+            .to_string(),
+        rule,
+        subjects: nail.map(|n| n.subject).into_iter().collect(),
+        evidence: lines,
+        consequences: Vec::new(),
+        verdict: index,
+    }
+}
+
+/// Nails listed compactly: `A -> B #1, #2; A -> C #1`.
+pub fn fold_ids(ids: &[String]) -> String {
+    let mut groups: Vec<(&str, Vec<&str>)> = Vec::new();
+    for id in ids {
+        let (pair, k) = id.rsplit_once(" #").unwrap_or((id, ""));
+        match groups.iter_mut().find(|(p, _)| *p == pair) {
+            Some((_, ks)) => ks.push(k),
+            None => groups.push((pair, vec![k])),
+        }
+    }
+    groups
+        .iter()
+        .map(|(pair, ks)| {
+            let ks: Vec<String> = ks
+                .iter()
+                .filter(|k| !k.is_empty())
+                .map(|k| format!("#{k}"))
+                .collect();
+            if ks.is_empty() {
+                pair.to_string()
+            } else {
+                format!("{pair} {}", ks.join(", "))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nail_reasons_split_into_the_nail_and_its_cause() {
+        let n = nail_reason("nail A/0 -> B/1 #12: A/0 was not placed").unwrap();
+        assert_eq!(
+            (n.subject.as_str(), n.cause),
+            ("A/0 -> B/1 #12", "A/0 was not placed")
+        );
+        let n = nail_reason("nail A -> B #3 beyond reach: the wrist centre would be 3 m").unwrap();
+        assert_eq!(
+            (n.subject.as_str(), n.cause),
+            ("A -> B #3", "beyond reach: the wrist centre would be 3 m")
+        );
+        assert!(nail_reason("place pose: every solution collides").is_none());
+    }
+
+    #[test]
+    fn a_nail_cause_names_the_element_it_and_its_partner_the_other_piece() {
+        let n = nail_reason("nail P -> M #1: P and M were not placed").unwrap();
+        assert_eq!(in_words(&n, "M"), "the other piece and it were not placed");
+        let n = nail_reason("nail P -> M #1: P was not placed").unwrap();
+        assert_eq!(in_words(&n, "P"), "it was not placed");
+        assert_eq!(in_words(&n, "M"), "the other piece was not placed");
+    }
+
+    #[test]
+    fn nails_fold_by_pair() {
+        let ids: Vec<String> = ["A -> B #1", "A -> B #2", "A -> C #1"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        assert_eq!(fold_ids(&ids), "A -> B #1, #2; A -> C #1");
+    }
+}
