@@ -175,6 +175,13 @@ fn a_long_wall_is_simulated_panel_by_panel_and_an_edit_redoes_one_panel() {
         String::from_utf8_lossy(&why.stderr)
     );
     let text = String::from_utf8_lossy(&why.stdout);
+    // The panel named as `simulate` names it.
+    let panel = failed["panel_id"].as_str().unwrap();
+    assert!(
+        text.lines().nth(1).unwrap().contains(", panel ")
+            && text.contains(&format!(" ({panel})\n")),
+        "{text}"
+    );
     let sizes: Vec<f64> = text
         .split("wall_size(\"")
         .skip(1)

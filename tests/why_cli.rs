@@ -270,6 +270,28 @@ fn bad_ids_and_tuples_exit_2_with_a_clear_message() {
     );
 }
 
+/// The wall of TM3's top plate as `plan` names it: `Wall 1 (W1)`.
+fn top_plate_wall() -> String {
+    let plan: serde_json::Value =
+        serde_json::from_str(&ok(&["plan", tm3().to_str().unwrap(), "--json"])).unwrap();
+    let wall = plan["walls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| {
+            w["member_ids"]
+                .as_array()
+                .unwrap()
+                .contains(&serde_json::json!("32H5oapRpM57uELNCcVku8"))
+        })
+        .expect("the top plate is in a wall");
+    format!(
+        "{} ({})",
+        wall["name"].as_str().unwrap(),
+        wall["wall_id"].as_str().unwrap()
+    )
+}
+
 #[test]
 fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
     // The study's finding: TM3's top plate cannot be placed on the ABB cell,
@@ -290,13 +312,21 @@ fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
     let args = [&args[..], &["--verbose"]].concat();
     let first = ok(&args);
     assert!(
-        answer.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n")
-            && first.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ (from the cache)\n"),
+        answer.starts_with(&format!("simulated {}\n", top_plate_wall()))
+            && first.starts_with(&format!(
+                "simulated {} (from the cache)\n",
+                top_plate_wall()
+            )),
         "{answer}"
     );
     // The answer first: the cause with its numbers, the nails it cost folded, under 30 lines.
     let lines: Vec<&str> = answer.lines().collect();
     assert!(lines.len() < 30, "{answer}");
+    // Its wall named as `plan` and `simulate` name it.
+    assert!(
+        lines[1].ends_with(&format!(", in {}", top_plate_wall())),
+        "{answer}"
+    );
     assert!(
         lines[4].starts_with(
             "framing failed (Robot): place pose beyond reach: the wrist centre would be "
@@ -392,7 +422,7 @@ fn why_simulates_the_wall_of_the_tm3_top_plate_and_caches_it() {
     assert_eq!(counted as usize, nails);
     // Afresh, it says the same as from the cache.
     let fresh = ok(&[&args[..args.len() - 3], &["--no-cache", "--verbose"]].concat());
-    assert!(fresh.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"));
+    assert!(fresh.starts_with(&format!("simulated {}\n", top_plate_wall())));
     assert_eq!(
         first.lines().skip(1).collect::<Vec<_>>(),
         fresh.lines().skip(1).collect::<Vec<_>>()
@@ -440,16 +470,19 @@ fn why_takes_the_cache_options_of_the_other_commands() {
 
     let first = why(&["--cache", named.path().to_str().unwrap()]);
     assert!(
-        first.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"),
+        first.starts_with(&format!("simulated {}\n", top_plate_wall())),
         "{first}"
     );
     assert!(entries(named.path()) > 0, "the named folder holds the wall");
     let again = why(&["--cache", named.path().to_str().unwrap()]);
-    assert!(again.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ (from the cache)\n"));
+    assert!(again.starts_with(&format!(
+        "simulated {} (from the cache)\n",
+        top_plate_wall()
+    )));
 
     let fresh = why(&["--no-cache"]);
     assert!(
-        fresh.starts_with("simulated wall 07l14Rb8lVjg1i9SI4wpQJ\n"),
+        fresh.starts_with(&format!("simulated {}\n", top_plate_wall())),
         "{fresh}"
     );
     assert_eq!(entries(default.path()), 0, "--no-cache wrote nothing");

@@ -8,6 +8,7 @@ use super::{CmdResult, Failure, print_stdout};
 use framewright::frame::RuleLimits;
 use framewright::frame::containers::{containers_of, restrict_to_containers};
 use framewright::frame::panel_why;
+use framewright::frame::panelize::{PanelOf, panels_by_piece};
 use framewright::frame::placement::{add_placement_facts, reason_placed};
 use framewright::frame::plan::Plan;
 use framewright::logic::compiled::Relations;
@@ -15,7 +16,7 @@ use framewright::sim::{prepare_facts, whole_facts};
 use framewright::user_rules::render::{render_answer, render_why, render_why_not};
 use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
 use framewright::user_rules::why::{
-    Context, WhyError, element_walls_split, resolve_element, why, why_not,
+    Context, WhyError, element_walls_split, name_walls, resolve_element, why, why_not,
 };
 use serde::Serialize;
 use std::collections::BTreeSet;
@@ -70,7 +71,10 @@ pub struct Common {
 /// A wall simulated for the explanation.
 #[derive(Serialize)]
 struct Simulated {
+    /// The rules' name for it (its key piece).
     wall: String,
+    /// As every command names it: `Wall 1 (W1)`, `Wall 1, panel 2 (W1-P2)`.
+    label: Option<String>,
     from_cache: bool,
 }
 
@@ -135,6 +139,7 @@ fn simulate_walls(
         facts.extend(sim);
         out.push(Simulated {
             wall,
+            label: None,
             from_cache: cached,
         });
     }
@@ -177,9 +182,10 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     c.check_simulation()?;
     let base = rule_base(&c.inputs.rules_dir);
     let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
+    // The whole model's plan names walls and panels as every other command does.
+    let (plan, _) = plan_of(facts.clone(), &cell, &base, &model)?;
     // A panel, a plate segment or an added stud: not a piece of the model but of the plan.
     if panel_why::names_a_panel_part(&args.id) && resolve_element(&model, &args.id).is_err() {
-        let (plan, _) = plan_of(facts, &cell, &base, &model)?;
         let answer = panel_why::why(&plan, &cell, &args.id).ok_or_else(|| {
             Failure::bad_input(format!(
                 "`{}` names no panel, plate segment, added stud or site piece of the plan (panels are WALL-Pn, segments PLATE~k, added studs STUD~endN, site pieces PLATE~lapK; `framewright plan --json` lists them)",
@@ -194,7 +200,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
     let mut facts = restrict_to_containers(&facts, &containers_of(&facts, &ids));
     add_placement_facts(&mut facts, &cell, &base)?;
-    let (simulated, panelized) = simulate_walls(
+    let (mut simulated, panelized) = simulate_walls(
         c,
         &args.model,
         &model,
@@ -202,13 +208,18 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         &mut facts,
         std::slice::from_ref(&args.id),
     )?;
+    let names = panels_by_piece(&plan);
+    for s in &mut simulated {
+        s.label = names.get(&s.wall).map(PanelOf::label);
+    }
     let ctx = Context {
         model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,
         base: &base,
         user_files: &c.rules,
     };
-    let reports = why(&ctx, &args.id).map_err(failure)?;
+    let mut reports = why(&ctx, &args.id).map_err(failure)?;
+    name_walls(&mut reports, &names);
     let text = if c.json {
         #[derive(Serialize)]
         struct Elements<'a, T> {
@@ -228,8 +239,10 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         let mut text = String::new();
         for s in &simulated {
             text.push_str(&format!(
-                "simulated wall {}{}\n",
-                s.wall,
+                "simulated {}{}\n",
+                s.label
+                    .clone()
+                    .unwrap_or_else(|| format!("wall {}", s.wall)),
                 if s.from_cache {
                     " (from the cache)"
                 } else {

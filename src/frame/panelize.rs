@@ -35,6 +35,32 @@ pub struct PanelOf {
     pub index: usize,
 }
 
+impl PanelOf {
+    /// What the cell builds, as every command names it: the panel of a split wall (`W1-P2`),
+    /// or the wall that fits (`W1`).
+    pub fn unit_id(&self) -> &str {
+        if self.index > 0 {
+            &self.panel_id
+        } else {
+            &self.wall_id
+        }
+    }
+
+    /// `Wall 1, panel 2` or `Wall 1`.
+    pub fn unit_name(&self) -> String {
+        if self.index > 0 {
+            format!("{}, panel {}", self.wall_name, self.index)
+        } else {
+            self.wall_name.clone()
+        }
+    }
+
+    /// `Wall 1, panel 2 (W1-P2)`, `Wall 1 (W1)`: as `simulate` prints it.
+    pub fn label(&self) -> String {
+        format!("{} ({})", self.unit_name(), self.unit_id())
+    }
+}
+
 /// A model whose split walls are cut into panels.
 pub struct Panelized {
     pub model: Model,

@@ -337,15 +337,7 @@ impl Plan {
             let Some(of) = panel_of.get(&wall.key) else {
                 continue;
             };
-            let split = of.index > 0;
-            let (id, name) = if split {
-                (
-                    of.panel_id.clone(),
-                    format!("{}, panel {}", of.wall_name, of.index),
-                )
-            } else {
-                (of.wall_id.clone(), of.wall_name.clone())
-            };
+            let (id, name) = (of.unit_id().to_string(), of.unit_name());
             renamed.insert(std::mem::replace(&mut wall.id, id), wall.id.clone());
             wall.name = name;
             match splits.get(of.wall_key.as_str()) {

@@ -34,9 +34,11 @@ fn element_line(s: &mut String, r: &WhyReport) {
         e.ifc_type,
         e.entity,
         e.global_id,
-        r.wall
-            .as_ref()
-            .map_or(String::from(", in no wall"), |w| format!(", wall {w}"))
+        match (&r.wall_label, &r.wall) {
+            (Some(label), _) => format!(", in {label}"),
+            (None, Some(key)) => format!(", wall {key}"),
+            (None, None) => ", in no wall".to_string(),
+        }
     );
 }
 

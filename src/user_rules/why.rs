@@ -8,12 +8,13 @@
 use super::answer::{Answer, answer};
 use super::{UserRulesError, full_program};
 use crate::frame::containers::{containers_of, restrict_to_containers};
+use crate::frame::panelize::PanelOf;
 use crate::frame::{Facts, RuleEngine};
 use crate::ifc::{Model, Piece};
 use crate::logic::provenance::{Explanation, How, Premise, WhyNot, parse_query};
 use crate::logic::{Engine, LogicError, Options, Origin, Value};
 use serde::Serialize;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -234,8 +235,12 @@ pub struct Verdict {
 #[derive(Clone, Debug, Serialize)]
 pub struct WhyReport {
     pub element: ElementInfo,
-    /// The element's wall, when it is in one.
+    /// The element's wall, when it is in one (the rules' name: its key piece).
     pub wall: Option<String>,
+    /// The wall or panel as every command names it (`W1`, `W1-P2`; see `name_walls`).
+    pub wall_id: Option<String>,
+    /// `Wall 1 (W1)`, `Wall 1, panel 2 (W1-P2)`: as `simulate` prints it.
+    pub wall_label: Option<String>,
     /// The answer first: causes with their numbers, consequences folded (`answer::answer`).
     pub answer: Answer,
     pub verdicts: Vec<Verdict>,
@@ -281,11 +286,24 @@ pub fn why_piece(engine: &Engine, piece: &Piece) -> Result<WhyReport, WhyError> 
     let mut report = WhyReport {
         element: ElementInfo::of(piece),
         wall,
+        wall_id: None,
+        wall_label: None,
         answer: Answer::default(),
         verdicts,
     };
     report.answer = answer(&report);
     Ok(report)
+}
+
+/// Names each report's wall as the plan of the whole model does (`panels_by_piece` of it):
+/// the rules know a wall by its key piece, the user by `W1` or `W1-P2`.
+pub fn name_walls(reports: &mut [WhyReport], names: &BTreeMap<String, PanelOf>) {
+    for r in reports {
+        if let Some(of) = names.get(&r.element.id) {
+            r.wall_id = Some(of.unit_id().to_string());
+            r.wall_label = Some(of.label());
+        }
+    }
 }
 
 /// Rules, IFC entities, cell keys and simulation facts a tree rests on.
