@@ -785,8 +785,22 @@ fn the_report_shows_each_panel_on_its_own_with_the_walls_panels() {
         panels.len(),
         "one panel table per panel section"
     );
+    // Each section draws the whole wall with its breaks where the plan put them, its own panel
+    // marked.
+    let breaks = plan["walls"][0]["panel_breaks"].as_array().unwrap();
+    assert_eq!(
+        page.matches("<line class=\"break\"").count(),
+        breaks.len() * panels.len()
+    );
+    for b in breaks {
+        assert!(page.contains(&format!("u = {:.3} m", f(&b["u"]))));
+    }
     for p in panels {
         let id = p["panel_id"].as_str().unwrap();
+        assert!(
+            page.contains(&format!("<g class=\"panel this\" data-panel=\"{id}\">")),
+            "{id}'s section does not mark its panel on the wall"
+        );
         assert!(page.contains(&format!("<td>{id}</td>")), "no row for {id}");
         assert!(
             page.contains(&format!("({id})</h2>")),

@@ -316,6 +316,8 @@ fn panels(w: &WallView) -> Markup {
         @if let Some(of) = w.panel {
             h3 { "Panel" }
             p { (format!("Panel {} of {} of {} ({}): the wall is longer or heavier than the cell builds, so it is built as {} panels (rules/panels.dl; framewright why MODEL {} explains this panel). This section frames and nails {} on its own; its cut plate segments (PLATE~k) and added end studs (STUD~endK) are pieces like any other.", of.index, split.panels.len(), of.wall_name, of.wall_id, split.panels.len(), of.panel_id, of.panel_id)) }
+            (svg::panel_strip(split, &of.panel_id))
+            p class="legend" { (format!("The whole of {} along its length: this panel shaded, breaks dashed with their position u from the wall's start, stretches of lapped plates fixed on site in orange.", of.wall_name)) }
             table class="panels" {
                 tr { th { "panel" } th { "u from (m)" } th { "u to (m)" } th { "length (m)" } th { "height (m)" } th { "mass (kg)" } th { "members" } th { "plate segments" } th { "added end studs" } th { "exceeds" } }
                 @for p in &split.panels {

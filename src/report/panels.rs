@@ -70,15 +70,24 @@ pub struct AddedRow<'a> {
     pub mass: f64,
 }
 
-/// A stretch of a lapped plate across a joint, fixed on site.
+impl<'a> CutRow<'a> {
+    fn new(id: &'a str, of: &'a str, u_start: f64, u_end: f64, mass: f64) -> CutRow<'a> {
+        CutRow {
+            id,
+            of,
+            u_start: round_m(u_start),
+            u_end: round_m(u_end),
+            length: round_m(u_end - u_start),
+            mass: round_kg(mass),
+        }
+    }
+}
+
+/// A stretch of a lapped plate across a joint, fixed on site: a cut piece in no panel.
 #[derive(Debug, Serialize)]
 pub struct SiteRow<'a> {
-    pub id: &'a str,
-    pub of: &'a str,
-    pub u_start: f64,
-    pub u_end: f64,
-    pub length: f64,
-    pub mass: f64,
+    #[serde(flatten)]
+    pub piece: CutRow<'a>,
     /// The panels it laps over.
     pub laps: &'a [String],
 }
@@ -105,14 +114,7 @@ pub fn panel_rows(split: &WallPanels) -> Vec<PanelRow<'_>> {
             cut_pieces: p
                 .cut_pieces
                 .iter()
-                .map(|c| CutRow {
-                    id: &c.id,
-                    of: &c.of,
-                    u_start: round_m(c.u_start),
-                    u_end: round_m(c.u_end),
-                    length: round_m(c.u_end - c.u_start),
-                    mass: round_kg(c.mass),
-                })
+                .map(|c| CutRow::new(&c.id, &c.of, c.u_start, c.u_end, c.mass))
                 .collect(),
             added_pieces: p
                 .added_pieces
@@ -136,12 +138,7 @@ pub fn site_rows(split: &WallPanels) -> Vec<SiteRow<'_>> {
         .site_pieces
         .iter()
         .map(|s| SiteRow {
-            id: &s.id,
-            of: &s.of,
-            u_start: round_m(s.u_start),
-            u_end: round_m(s.u_end),
-            length: round_m(s.u_end - s.u_start),
-            mass: round_kg(s.mass),
+            piece: CutRow::new(&s.id, &s.of, s.u_start, s.u_end, s.mass),
             laps: &s.laps,
         })
         .collect()

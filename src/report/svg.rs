@@ -7,6 +7,7 @@ use super::simulate::SimReport;
 use super::verdict;
 use super::wall_view::{PieceView, WallView};
 use crate::cell::Cell;
+use crate::frame::panels::WallPanels;
 use crate::sim::Simulation;
 use maud::{Markup, html};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
@@ -120,6 +121,48 @@ pub(super) fn elevation(view: &WallView) -> Markup {
                 }
             }
             (scale_bar(MARGIN, height - 15.0, s))
+        }
+    }
+}
+
+/// The whole wall a panel belongs to, from the side: each panel a box along u (`this` filled),
+/// each break a dashed line with its u, each site piece (a lapped cap across a joint) a bar
+/// along the top. Panels carry `data-panel`, not `data-id`: they are not pieces.
+pub(super) fn panel_strip(panels: &WallPanels, this: &str) -> Markup {
+    let length = panels.panels.last().map_or(0.0, |p| p.u_end).max(0.1);
+    let high = panels
+        .panels
+        .iter()
+        .map(|p| p.height)
+        .fold(0.5_f64, f64::max);
+    let s = (WIDTH - 2.0 * MARGIN) / length;
+    let (top, band) = (MARGIN, (high * s).min(120.0));
+    let height = top + band + 2.0 * MARGIN;
+    let x = |u: f64| MARGIN + u * s;
+    html! {
+        svg xmlns="http://www.w3.org/2000/svg" class="panel-strip" width=(f1(WIDTH)) height=(f1(height))
+            viewBox=(format!("0 0 {} {}", f1(WIDTH), f1(height))) {
+            @for p in &panels.panels {
+                g class=(if p.id == this { "panel this" } else { "panel" }) data-panel=(p.id) {
+                    title { (format!("{}: u {:.3} to {:.3} m, {:.3} m long, {:.1} kg", p.id, p.u_start, p.u_end, p.length(), p.mass)) }
+                    rect x=(f1(x(p.u_start))) y=(f1(top)) width=(f1(p.length() * s)) height=(f1(band))
+                        fill=(if p.id == this { "#bbdefb" } else { "#f5f5f5" }) stroke="#222" stroke-width="1" {}
+                    text x=(f1(x((p.u_start + p.u_end) / 2.0))) y=(f1(top + band / 2.0 + 4.0)) font-size="11" text-anchor="middle" { (p.id) }
+                }
+            }
+            @for b in &panels.breaks {
+                line class="break" x1=(f1(x(b.u))) y1=(f1(top - 8.0)) x2=(f1(x(b.u))) y2=(f1(top + band + 8.0))
+                    stroke="#c62828" stroke-width="2" stroke-dasharray="6 3" {
+                    title { (b.reason) }
+                }
+                text x=(f1(x(b.u))) y=(f1(top + band + 22.0)) font-size="10" text-anchor="middle" { (format!("u = {:.3} m", b.u)) }
+            }
+            @for site in &panels.site_pieces {
+                rect class="site-piece" x=(f1(x(site.u_start))) y=(f1(top - 6.0)) width=(f1((site.u_end - site.u_start) * s)) height="5"
+                    fill="#ef6c00" {
+                    title { (format!("{}: fixed on site across {}, u {:.3} to {:.3} m", site.id, site.laps.join(" and "), site.u_start, site.u_end)) }
+                }
+            }
         }
     }
 }
