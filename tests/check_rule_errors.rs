@@ -74,6 +74,25 @@ fn deriving_into_a_builtin_relation_is_refused() {
 }
 
 #[test]
+fn a_shop_preference_for_the_built_in_rules_points_to_a_rule_base() {
+    // `break_forbidden` is left empty by the built-in rules for a shop to fill; it feeds the
+    // panel breaks, which run before user rule files: the hint says where such a rule goes.
+    let (msg, _, _d) = load_err(
+        "break_forbidden(w, 0.0, 1.0, \"no joint at the start\") :- wall_size(w, _, _, _).\n",
+    );
+    assert!(
+        msg.contains(
+            "derives into the built-in relation `break_forbidden`, declared at rules/panels.dl:"
+        ) && msg.contains("`break_forbidden` feeds the built-in rules")
+            && msg.contains("--rules-dir DIR"),
+        "{msg}"
+    );
+    // A relation the built-in rules derive keeps the other hint.
+    let (msg, _, _d) = load_err("role(p, \"stud\") :- piece(p, _, _, _).\n");
+    assert!(msg.contains("may read `role` but not change it"), "{msg}");
+}
+
+#[test]
 fn redeclaring_the_findings_relations_is_refused() {
     let (msg, _, _d) = load_err(".decl violation(id: symbol, rule: symbol, message: symbol)\n");
     assert!(

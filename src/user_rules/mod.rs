@@ -408,6 +408,7 @@ fn refuse_redeclarations(files: &[PathBuf], base: &Program) -> Result<(), UserRu
                     name,
                     &place,
                     "declares",
+                    false,
                 ));
             }
         }
@@ -419,7 +420,16 @@ fn refuse_redeclarations(files: &[PathBuf], base: &Program) -> Result<(), UserRu
     }
 }
 
-fn redefinition(sources: &[Source], span: Span, name: &str, place: &str, verb: &str) -> Diagnostic {
+/// `feeds_base`: no built-in rule derives the relation (an input, or a hook such as
+/// `break_forbidden` left empty for a shop): what a user adds to it belongs in a rule base.
+fn redefinition(
+    sources: &[Source],
+    span: Span,
+    name: &str,
+    place: &str,
+    verb: &str,
+    feeds_base: bool,
+) -> Diagnostic {
     let what = if FINDING_RELATIONS.contains(&name) {
         "the findings relation"
     } else {
@@ -428,6 +438,10 @@ fn redefinition(sources: &[Source], span: Span, name: &str, place: &str, verb: &
     let hint = if FINDING_RELATIONS.contains(&name) {
         format!(
             "`{name}` is already declared as {name}(id: symbol, rule: symbol, message: symbol); derive it without declaring it"
+        )
+    } else if feeds_base {
+        format!(
+            "`{name}` feeds the built-in rules, which run before user rule files: put this file in a rule base instead (copy `rules/` to a directory, add the file there, and pass `--rules-dir DIR`)"
         )
     } else {
         format!(
@@ -448,6 +462,7 @@ fn refuse_base_heads(
     base: &Program,
     first_user_source: usize,
 ) -> Result<(), UserRulesError> {
+    let derived: BTreeSet<&str> = base.rules.iter().map(|r| r.head.rel.as_str()).collect();
     let errors: Vec<Diagnostic> = program
         .rules
         .iter()
@@ -460,6 +475,7 @@ fn refuse_base_heads(
                 &r.head.rel,
                 &base.location(decl.span),
                 "derives into",
+                !derived.contains(r.head.rel.as_str()),
             ))
         })
         .collect();
