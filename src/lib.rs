@@ -14,6 +14,7 @@ pub mod frame;
 pub mod geom;
 pub mod ifc;
 pub mod logic;
+pub mod program;
 pub mod report;
 pub mod sim;
 pub mod step;

@@ -102,6 +102,7 @@ struct Rec {
     fed: Vec<(String, u64)>,
     not_fed: Vec<(String, String)>,
     grip_failed: Vec<(String, String)>,
+    grips: Vec<(String, u64)>,
     nails: Vec<NailBits>,
     belt_events: Vec<(u64, String, String, String)>,
     framing_end: u64,
@@ -267,6 +268,7 @@ impl From<&WallRecord> for Rec {
             fed: r.fed.iter().map(|(p, t)| (p.clone(), bits(*t))).collect(),
             not_fed: r.not_fed.clone(),
             grip_failed: r.grip_failed.clone(),
+            grips: r.grips.iter().map(|(p, g)| (p.clone(), bits(*g))).collect(),
             nails: r
                 .nails
                 .iter()
@@ -367,8 +369,9 @@ impl Rec {
         }
         Some(WallRecord {
             // The pose trace (for the report's animation) is not cached: `simulate --report`
-            // simulates every wall.
+            // simulates every wall; nor is the robot's program (`program` simulates its walls).
             trace: Default::default(),
+            program: Vec::new(),
             wall: self.wall,
             operations,
             ik,
@@ -385,6 +388,7 @@ impl Rec {
             fed: self.fed.into_iter().map(|(p, t)| (p, float(t))).collect(),
             not_fed: self.not_fed,
             grip_failed: self.grip_failed,
+            grips: self.grips.into_iter().map(|(p, g)| (p, float(g))).collect(),
             nails: self
                 .nails
                 .into_iter()
@@ -440,6 +444,7 @@ mod tests {
     fn sample() -> WallRecord {
         WallRecord {
             trace: Default::default(),
+            program: Vec::new(),
             wall: "2Ab$x".into(),
             operations: vec![Operation {
                 piece: "p1".into(),
@@ -473,6 +478,7 @@ mod tests {
             fed: vec![("p1".into(), 2.5)],
             not_fed: vec![("p3".into(), "too long".into())],
             grip_failed: vec![],
+            grips: vec![("p1".into(), -0.25)],
             nails: vec![NailRecord {
                 plate: "bp".into(),
                 member: "s1".into(),

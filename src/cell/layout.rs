@@ -5,6 +5,7 @@
 use super::builtin;
 use super::error::CellError;
 use super::ik::IkFailure;
+use super::io::Io;
 use super::load::looks_like_path;
 use super::panels::{PanelLimits, PanelMode};
 use super::robot::Robot;
@@ -36,6 +37,8 @@ struct CellFile {
     #[serde(default)]
     panels: PanelLimits,
     track: Option<TrackSection>,
+    #[serde(default)]
+    io: Io,
 }
 
 /// `[track]`: the robot's base on a linear axis (see `track.rs`).
@@ -171,6 +174,10 @@ pub struct Motion {
     pub release_dwell: f64,
     /// Firing one nail, s.
     pub fire_dwell: f64,
+    /// How close a robot program's free moves pass their intermediate points (m): the zone
+    /// of a joint move followed by another move. Default 0.005, the clearance the executor
+    /// keeps along free moves, so a rounded corner stays within the clearance checked.
+    pub free_zone: f64,
 }
 
 impl Default for Motion {
@@ -184,6 +191,7 @@ impl Default for Motion {
             grip_dwell: 0.5,
             release_dwell: 0.3,
             fire_dwell: 0.2,
+            free_zone: 0.005,
         }
     }
 }
@@ -392,6 +400,8 @@ pub struct Cell {
     pub track: Option<Track>,
     /// `[panels]`: the limits walls are split to.
     pub panels: PanelLimits,
+    /// `[io]`: the signals a robot program drives and waits on.
+    pub io: Io,
     /// Whether walls are split (`--panels`; not a file key).
     pub panel_mode: PanelMode,
 }
@@ -622,6 +632,7 @@ impl Cell {
         size("tool_table", "leg_height", &[t.leg_height], 5.0)?;
         size("floor", "size", &f.floor.size, 1000.0)?;
         check_motion(&f.motion).map_err(|(key, m)| bad("motion", key, m))?;
+        f.io.check().map_err(|(key, m)| bad("io", key, m))?;
         if let Some(tr) = &f.track {
             finite_angle("track", "direction_deg", tr.direction_deg)?;
             size("track", "length", &[tr.length], 100.0)?;
@@ -747,6 +758,7 @@ impl Cell {
             },
             track,
             panels: f.panels,
+            io: f.io,
             panel_mode: PanelMode::default(),
         };
         cell.check_pick(&s.pick_heights)
@@ -883,6 +895,15 @@ fn check_motion(m: &Motion) -> Result<(), (&'static str, String)> {
         if !(v.is_finite() && (0.0..=60.0).contains(&v)) {
             return Err((key, format!("expected a time in s from 0 to 60, got {v}")));
         }
+    }
+    if !(m.free_zone.is_finite() && (0.0..=0.2).contains(&m.free_zone)) {
+        return Err((
+            "free_zone",
+            format!(
+                "expected a distance in m from 0 to 0.2, got {}",
+                m.free_zone
+            ),
+        ));
     }
     Ok(())
 }

@@ -9,6 +9,7 @@ mod builtin;
 mod dls;
 mod error;
 mod ik;
+pub mod io;
 mod layout;
 mod load;
 mod meta;

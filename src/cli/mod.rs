@@ -8,6 +8,7 @@ pub mod check;
 pub mod diff;
 pub mod inspect;
 pub mod plan;
+pub mod program;
 pub mod robot;
 pub mod rules;
 pub mod simulate;

@@ -67,6 +67,10 @@ pub struct ElementRow {
     /// The panel it is built in (`W1-P2`; `W1-P1` when the wall is one panel).
     pub panel_id: String,
     pub role: String,
+    /// Where the gripper held it as it was placed: m along the member from its centre,
+    /// positive towards the `axis_end` that `plan` prints (absent when it was not placed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grip_offset: Option<f64>,
     pub framing: ElementStage,
     pub nailing: ElementStage,
     /// Violations and warnings of the user's rules (`simulate --rules`) about this element.
@@ -333,6 +337,7 @@ impl SimReport {
                     wall_id: wall_id(&rec.wall),
                     panel_id: panel_id(&rec.wall),
                     role: sim.plan.roles.get(id).cloned().unwrap_or_default(),
+                    grip_offset: rec.grips.iter().find(|(p, _)| p == id).map(|(_, g)| r6(*g)),
                     framing: stage("framing", &framing),
                     nailing: stage("nailing", &nailing),
                     rule_findings: Vec::new(),

@@ -110,6 +110,8 @@ impl JointMove {
 pub struct LinearMove {
     pub from: Isometry3<f64>,
     pub to: Isometry3<f64>,
+    /// The programmed speed along the line, m/s.
+    pub speed: f64,
     pub profile: Profile,
 }
 
@@ -122,6 +124,7 @@ impl LinearMove {
         LinearMove {
             from,
             to,
+            speed,
             profile: Profile::fastest(speed / scale, accel / scale),
         }
     }

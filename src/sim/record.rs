@@ -102,6 +102,10 @@ pub struct WallRecord {
     pub grip_failed: Vec<(String, String)>,
     pub nails: Vec<NailRecord>,
     pub belt_events: Vec<BeltEvent>,
+    /// Where the grip TCP held each placed piece: metres along the piece from its centre,
+    /// positive towards its upper end (a vertical piece) or its larger-u end (the rest), as
+    /// `plan` orders a member's axis.
+    pub grips: Vec<(String, f64)>,
     pub framing_end: f64,
     pub nailing_end: f64,
     /// Physics steps taken.
@@ -109,6 +113,60 @@ pub struct WallRecord {
     /// The robot's and the lumber's poses over time, for animations.
     #[serde(skip)]
     pub trace: PoseTrace,
+    /// What the robot did, step by step, as a controller runs it (`program` writes it out).
+    #[serde(skip)]
+    pub program: Vec<RobotStep>,
+}
+
+/// One step of the robot's work as the executor ran it: the motions it validated, with the
+/// joints reached at each, and the tool's signals and waits between them.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RobotStep {
+    /// The steps up to the next `Begin` serve this piece, nail or the run's start.
+    Begin(StepFor),
+    /// A joint move (straight in joint space) to `q`, at a fraction of the joints' speed and
+    /// acceleration limits, taking `duration` s, with the TCP `tcp` of the tool active.
+    Joint {
+        q: Vec<f64>,
+        speed: f64,
+        duration: f64,
+        tcp: String,
+    },
+    /// A straight TCP move ending at `pose` (the TCP in the cell frame) with the joints at
+    /// `q`, at `speed` m/s along the line.
+    Line {
+        pose: Isometry3<f64>,
+        q: Vec<f64>,
+        tcp: String,
+        speed: f64,
+    },
+    /// The track's carriage moves to `s` (m from its home) with the arm's joints held at `q`.
+    Carriage { s: f64, q: Vec<f64> },
+    /// The jaws close on the piece.
+    Grip,
+    /// The jaws open.
+    Release,
+    /// The nailer fires.
+    Fire,
+    /// The robot waits for the touch sensor to report a piece.
+    AwaitPart,
+    /// The robot waits this long (s).
+    Dwell(f64),
+}
+
+/// What a stretch of robot steps serves.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StepFor {
+    /// The run's start: the arm at its home pose.
+    Start,
+    /// Feeding, picking and placing a piece.
+    Piece(String),
+    /// Driving nail `k` through `plate` into `member`.
+    Nail {
+        plate: String,
+        member: String,
+        k: i64,
+    },
 }
 
 /// How often the executor samples poses for the trace (s): 20 Hz.

@@ -122,6 +122,12 @@ impl<'a> WallRun<'a> {
         let base = track.base_at(to);
         self.cell.robot_base = base;
         self.phys.set_robot_base(base);
+        self.record
+            .program
+            .push(crate::sim::record::RobotStep::Carriage {
+                s: to,
+                q: self.q.clone(),
+            });
         Ok(())
     }
 

@@ -5,7 +5,7 @@ use super::{Held, WallRun, failure_score, raise};
 use crate::cell::{Arrangement, IkFailure};
 use crate::sim::motion::LinearMove;
 use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
-use crate::sim::record::IkRecord;
+use crate::sim::record::{IkRecord, RobotStep, StepFor};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
@@ -47,6 +47,9 @@ struct FramingPlan {
 
 impl<'a> WallRun<'a> {
     pub(super) fn frame(&mut self, piece: &'a ScenePiece) {
+        self.record
+            .program
+            .push(RobotStep::Begin(StepFor::Piece(piece.id.clone())));
         // Lumber the cell cannot handle never goes on the belts (`load_belts` leaves it
         // out): its verdict names why, not what the belts would have done to it (a 60 mm
         // block on edge topples at the end stop; a 58 m plate falls off the belts' ends).
@@ -59,6 +62,7 @@ impl<'a> WallRun<'a> {
             return;
         }
         let start = self.begin(&piece.id, "feed", &[]);
+        self.record.program.push(RobotStep::AwaitPart);
         let fed = self.await_piece(piece);
         self.end(&piece.id, "feed", start);
         if let Err(why) = fed {
@@ -79,6 +83,7 @@ impl<'a> WallRun<'a> {
             self.wait(0.1);
             waited += 0.1;
         }
+        self.record.program.push(RobotStep::Dwell(waited));
         if let Some(pose) = self.phys.lumber_pose(&piece.id)
             && piece.on_edge
             && (pose.rotation * Vector3::y()).z.abs() < 0.9
@@ -186,7 +191,8 @@ impl<'a> WallRun<'a> {
         // on a free piece would knock it over.
         self.phys.attach(id);
         self.phys.set_jaws(Some(piece.size[2]));
-        self.wait(self.cell.motion.grip_dwell);
+        self.record.program.push(RobotStep::Grip);
+        self.dwell(self.cell.motion.grip_dwell);
         self.held = Some(Held {
             id: id.to_string(),
             in_tool: tool.inverse() * body,
@@ -240,6 +246,7 @@ impl<'a> WallRun<'a> {
             // is taken out of the cell.
             self.record_line_failure(piece, "place", failure);
             self.phys.set_jaws(None);
+            self.record.program.push(RobotStep::Release);
             self.phys.detach(id);
             self.held = None;
             self.end(id, "move", start);
@@ -265,10 +272,14 @@ impl<'a> WallRun<'a> {
                 )
                 .map_err(|f| self.record_line_failure(piece, "place", f))
                 .is_ok();
+        if ok {
+            self.record_grip(piece, &grip);
+        }
         self.phys.set_jaws(None);
         self.phys.detach(id);
         self.held = None;
-        self.wait(self.cell.motion.release_dwell);
+        self.record.program.push(RobotStep::Release);
+        self.dwell(self.cell.motion.release_dwell);
         self.end(id, "place", start);
         let start = self.begin(id, "retract", &[]);
         let _ = self.run_line(
@@ -286,6 +297,23 @@ impl<'a> WallRun<'a> {
             self.phys.clamp(id);
             self.placed.insert(id.to_string(), plan.target);
         }
+    }
+
+    /// Where the grip TCP holds `piece` at its release: metres along the piece from its
+    /// target's centre, positive towards its upper end (a piece running up the wall) or its
+    /// larger-u end, as `plan` orders a member's axis.
+    fn record_grip(&mut self, piece: &ScenePiece, grip: &Isometry3<f64>) {
+        let tcp = self.cell.robot_base * self.cell.robot.fk_tip(&self.q) * grip;
+        let to_wall = self.wall_cell.inverse();
+        let point = (to_wall * tcp).translation.vector;
+        let target = to_wall * piece.target_cell;
+        let mut axis = target.rotation * Vector3::x();
+        let up_the_wall = axis.y.abs() > (axis.x * axis.x + axis.z * axis.z).sqrt();
+        if (up_the_wall && axis.y < 0.0) || (!up_the_wall && axis.x < 0.0) {
+            axis = -axis;
+        }
+        let offset = (point - target.translation.vector).dot(&axis);
+        self.record.grips.push((piece.id.clone(), offset));
     }
 
     /// A straight move of a framing that failed on the way: recorded against the piece, so

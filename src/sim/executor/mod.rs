@@ -23,7 +23,7 @@ use super::SimOptions;
 use super::motion::{JointMove, LinearMove};
 use super::physics::Physics;
 use super::reach::{check_step, solve};
-use super::record::{ContactRecord, Operation, WallRecord};
+use super::record::{ContactRecord, Operation, RobotStep, StepFor, WallRecord};
 use crate::cell::{Cell, IkFailure};
 use crate::world::{ScenePiece, SceneWall};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
@@ -138,6 +138,12 @@ impl<'a> WallRun<'a> {
     /// Runs the wall: framing of every element, then nailing. Err: the simulated time
     /// reached when the run went past its time limit.
     pub fn run(mut self, nails: &[NailPlan]) -> Result<WallRecord, f64> {
+        self.record.program.push(RobotStep::Begin(StepFor::Start));
+        let home = RobotStep::Carriage {
+            s: self.cell.carriage(),
+            q: self.q.clone(),
+        };
+        self.record.program.push(home);
         self.load_belts();
         self.phys.drive_robot(&self.q.clone());
         self.step();
@@ -217,6 +223,23 @@ impl<'a> WallRun<'a> {
         self.watch_contacts();
     }
 
+    /// A wait of the robot's program (a dwell at the grip, release or firing, a settle at
+    /// the sensor): recorded as a step of the program, then run.
+    fn dwell(&mut self, seconds: f64) {
+        self.record.program.push(RobotStep::Dwell(seconds));
+        self.wait(seconds);
+    }
+
+    /// The name of the tool's TCP `tcp` (as the tool file names it).
+    fn tcp_name(&self, tcp: &Isometry3<f64>) -> String {
+        self.cell
+            .tool
+            .tcps
+            .iter()
+            .find(|(_, t)| *t == tcp)
+            .map_or_else(|| "tool0".to_string(), |(name, _)| name.clone())
+    }
+
     fn wait(&mut self, seconds: f64) {
         let steps = (seconds / self.options.dt).ceil().max(1.0) as u64;
         for _ in 0..steps {
@@ -224,26 +247,57 @@ impl<'a> WallRun<'a> {
         }
     }
 
-    fn run_joint(&mut self, mv: &JointMove) {
+    /// Runs a joint move at `speed` (the fraction it was planned with), recorded as a step
+    /// of the program with the TCP `tcp` active.
+    fn run_joint(&mut self, mv: &JointMove, speed: f64, tcp: &Isometry3<f64>) {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
         for k in 1..=steps {
             self.q = mv.at(k as f64 * self.options.dt);
             self.tick();
         }
         self.q = mv.to.clone();
+        let tcp = self.tcp_name(tcp);
+        self.record.program.push(RobotStep::Joint {
+            q: self.q.clone(),
+            speed,
+            duration: mv.profile.duration,
+            tcp,
+        });
     }
 
     /// Follows a straight TCP line; stops (returning the failure) if IK fails on the way.
+    /// The stretch run is recorded as a step of the program, ending where the arm stopped.
     fn run_line(&mut self, mv: &LinearMove, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
         let steps = (mv.profile.duration / self.options.dt).ceil().max(1.0) as u64;
+        let mut reached = None;
+        let mut outcome = Ok(());
         for k in 1..=steps {
             let pose = mv.pose_at(k as f64 * self.options.dt);
-            let next = solve(&self.cell, &pose, tcp, &self.q)?;
-            check_step(&self.cell, &self.q, &next, k as f64 / steps as f64)?;
-            self.q = next;
-            self.tick();
+            let next = solve(&self.cell, &pose, tcp, &self.q).and_then(|next| {
+                check_step(&self.cell, &self.q, &next, k as f64 / steps as f64).map(|()| next)
+            });
+            match next {
+                Ok(next) => {
+                    self.q = next;
+                    reached = Some(pose);
+                    self.tick();
+                }
+                Err(failure) => {
+                    outcome = Err(failure);
+                    break;
+                }
+            }
         }
-        Ok(())
+        if let Some(pose) = reached {
+            let tcp_name = self.tcp_name(tcp);
+            self.record.program.push(RobotStep::Line {
+                pose,
+                q: self.q.clone(),
+                tcp: tcp_name,
+                speed: mv.speed,
+            });
+        }
+        outcome
     }
 
     fn begin(&mut self, piece: &str, op: &'static str, may_touch: &[&str]) -> f64 {

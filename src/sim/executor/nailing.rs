@@ -8,7 +8,7 @@ use crate::cell::tcp_poses::{nail_lines, nail_pose, nail_rolls, retreat};
 use crate::frame::plan::NailingTarget;
 use crate::sim::motion::LinearMove;
 use crate::sim::reach::{continuous_line_where, touches};
-use crate::sim::record::{NailOutcome, NailRecord, failure_columns};
+use crate::sim::record::{NailOutcome, NailRecord, RobotStep, StepFor, failure_columns};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
 /// The nailer approaches along the nail line from this far back (m).
@@ -85,6 +85,11 @@ impl<'a> WallRun<'a> {
     pub(super) fn nail_all(&mut self, nails: &[NailPlan]) {
         let nail_tcp = *self.cell.tool.tcp("nail").expect("cells have a nail TCP");
         for nail in nails {
+            self.record.program.push(RobotStep::Begin(StepFor::Nail {
+                plate: nail.plate.clone(),
+                member: nail.member.clone(),
+                k: nail.k,
+            }));
             let missing: Vec<&str> = [nail.plate.as_str(), nail.member.as_str()]
                 .into_iter()
                 .filter(|p| !self.placed.contains_key(*p))
@@ -137,7 +142,8 @@ impl<'a> WallRun<'a> {
             let fired_at = self.t;
             if reached {
                 self.phys.nail(&nail.plate, &nail.member);
-                self.wait(self.cell.motion.fire_dwell);
+                self.record.program.push(RobotStep::Fire);
+                self.dwell(self.cell.motion.fire_dwell);
             }
             let _ = self.run_line(
                 &LinearMove::new(

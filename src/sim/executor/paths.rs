@@ -48,7 +48,7 @@ impl<'a> WallRun<'a> {
         let path = self.clear_path(&from, to, tcp, ignore)?;
         for q in path.windows(2) {
             let mv = JointMove::new(&self.cell.robot, &q[0], &q[1], speed);
-            self.run_joint(&mv);
+            self.run_joint(&mv, speed, tcp);
         }
         Ok(())
     }
