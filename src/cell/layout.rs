@@ -176,7 +176,7 @@ pub struct Motion {
     pub fire_dwell: f64,
     /// How close a robot program's free moves pass their intermediate points (m): the zone
     /// of a joint move followed by another move. Default 0.005, the clearance the executor
-    /// keeps along free moves, so a rounded corner stays within the clearance checked.
+    /// keeps along free moves: at the TCP a rounded corner stays within the clearance checked.
     pub free_zone: f64,
 }
 

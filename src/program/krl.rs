@@ -110,7 +110,10 @@ pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
     let zone = cell.motion.free_zone * 1000.0;
     let blend = zone > 0.0;
     if blend {
+        // Straight moves blend by distance (mm); PTP blends by KRL's own criterion, a
+        // percentage: its smallest, 1 %.
         let _ = writeln!(s, "  $APO.CDIS = {}", num(zone, 1));
+        let _ = writeln!(s, "  $APO.CPTP = 1");
     }
     if cell.track.is_some() {
         let _ = writeln!(s, "  $VEL_EXTAX[1] = 100");
@@ -125,7 +128,7 @@ pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
             *tool = Some(data.clone());
         }
     };
-    let approx = |fine: bool| if !fine && blend { " C_DIS" } else { "" };
+    let approx = |fine: bool, criterion: &'static str| if !fine && blend { criterion } else { "" };
     for instr in &routine.body {
         match instr {
             Instr::Comment(text) => {
@@ -140,14 +143,15 @@ pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
             } => {
                 set_tool(s, &mut tool, tcp);
                 if axis_speed != Some(*speed) {
-                    let pct = num((speed * 100.0).clamp(1.0, 100.0), 1);
+                    // Whole percentages (KRL's $VEL_AXIS is an INT).
+                    let pct = (speed * 100.0).round().clamp(1.0, 100.0) as i64;
                     for axis in 1..=routine.joints[*target].q.len() {
                         let _ = writeln!(s, "  $VEL_AXIS[{axis}] = {pct}");
                         let _ = writeln!(s, "  $ACC_AXIS[{axis}] = {pct}");
                     }
                     axis_speed = Some(*speed);
                 }
-                let _ = writeln!(s, "  PTP XJ{}{}", target + 1, approx(*fine));
+                let _ = writeln!(s, "  PTP XJ{}{}", target + 1, approx(*fine, " C_PTP"));
             }
             Instr::Carriage { target, tcp } => {
                 set_tool(s, &mut tool, tcp);
@@ -164,7 +168,7 @@ pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
                     let _ = writeln!(s, "  $VEL.CP = {}", num(*speed, 4));
                     line_speed = Some(*speed);
                 }
-                let _ = writeln!(s, "  LIN XP{}{}", target + 1, approx(*fine));
+                let _ = writeln!(s, "  LIN XP{}{}", target + 1, approx(*fine, " C_DIS"));
             }
             Instr::Set { signal, on } => {
                 let value = if *on { "TRUE" } else { "FALSE" };
@@ -175,6 +179,10 @@ pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
             }
             Instr::Wait(seconds) => {
                 let _ = writeln!(s, "  WAIT SEC {}", num(*seconds, 3));
+            }
+            Instr::OperatorStop(message) => {
+                let _ = writeln!(s, "  ; {message}");
+                let _ = writeln!(s, "  HALT");
             }
         }
     }

@@ -34,6 +34,10 @@ pub enum Language {
 pub enum ProgramError {
     #[error("the cell's {0}")]
     Signal(String),
+    #[error(
+        "the robot {robot} has {dof} axes; RAPID and KRL programs are written for six-axis arms"
+    )]
+    Axes { robot: String, dof: usize },
     #[error("{path}: cannot write the program: {source}")]
     Write {
         path: PathBuf,
@@ -114,6 +118,12 @@ pub fn programs(
             (e.id.clone(), why)
         })
         .collect();
+    if cell.robot.dof() != 6 {
+        return Err(ProgramError::Axes {
+            robot: cell.robot.name.clone(),
+            dof: cell.robot.dof(),
+        });
+    }
     let mut taken = BTreeSet::new();
     let mut out = Vec::new();
     for (k, record) in sim.records.iter().enumerate() {
@@ -122,11 +132,13 @@ pub fn programs(
         };
         let plan_wall = sim.plan.walls.iter().find(|w| w.key == record.wall);
         let wall_in_world = scene_wall.wall_to_robot;
+        let fed: BTreeSet<String> = record.fed.iter().map(|(id, _)| id.clone()).collect();
         let routine = routine::routine(&RoutineInput {
             cell,
             record,
             wall_in_cell: cell.robot_base * wall_in_world,
             framed: &framed,
+            fed: &fed,
             reasons: &reasons,
         });
         let (id, label) = plan_wall.map_or_else(
@@ -170,8 +182,11 @@ fn program_name(id: &str, k: usize, taken: &mut BTreeSet<String>) -> String {
     } else {
         format!("fw_wall{k}")
     };
-    if taken.contains(&name.to_ascii_lowercase()) {
-        name = format!("fw_wall{k}");
+    // File names must not collide (a wall `Wall3` and the third wall's fallback name).
+    let mut n = k;
+    while taken.contains(&name.to_ascii_lowercase()) {
+        name = format!("fw_wall{n}");
+        n += 1;
     }
     taken.insert(name.to_ascii_lowercase());
     name

@@ -59,7 +59,7 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
         let com = cell.tool.centre_of_mass;
         let _ = writeln!(
             w,
-            "  PERS tooldata {data} := [TRUE,{},[{},[{},{},{}],[1,0,0,0],0,0,0]];",
+            "  LOCAL PERS tooldata {data} := [TRUE,{},[{},[{},{},{}],[1,0,0,0],0,0,0]];",
             pose(&frame),
             num(cell.tool.mass.max(0.001), 3),
             mm(com[0]),
@@ -73,25 +73,23 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
     );
     let _ = writeln!(
         w,
-        "  PERS wobjdata wall1 := [FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
+        "  LOCAL PERS wobjdata wall1 := [FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];",
         pose(&program.wall_in_world)
     );
     let track_speed = cell.track.map_or(5000.0, |t| t.speed * 1000.0);
+    // Free moves run in their simulated time (`\T`), the carriage at the track's speed;
+    // the first move, from wherever the arm stands, at a cautious 250 mm/s.
     let _ = writeln!(
         w,
-        "  CONST speeddata vjoint := [7000,1000,{},1000];",
+        "  LOCAL CONST speeddata vjoint := [7000,1000,{},1000];",
         num(track_speed, 1)
     );
-    let _ = writeln!(
-        w,
-        "  CONST speeddata vtrack := [7000,1000,{},1000];",
-        num(track_speed, 1)
-    );
+    let _ = writeln!(w, "  LOCAL CONST speeddata vhome := [250,30,250,30];");
     for (k, speed) in speeds.iter().enumerate() {
         // A pure turn along a line runs at speed / 0.2 rad/s (see `sim::motion::LinearMove`).
         let _ = writeln!(
             w,
-            "  CONST speeddata vline{} := [{},{},{},1000];",
+            "  LOCAL CONST speeddata vline{} := [{},{},{},1000];",
             k + 1,
             num(speed * 1000.0, 1),
             num((speed / 0.2).to_degrees(), 1),
@@ -101,7 +99,7 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
     let free_zone = if zone > 0.0 {
         let _ = writeln!(
             w,
-            "  CONST zonedata zfree := [FALSE,{},{},{},{},{},{}];",
+            "  LOCAL CONST zonedata zfree := [FALSE,{},{},{},{},{},{}];",
             num(zone, 1),
             num(zone * 1.6, 1),
             num(zone * 1.6, 1),
@@ -117,7 +115,7 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
         let axes: Vec<String> = j.q.iter().map(|v| deg(*v)).collect();
         let _ = writeln!(
             w,
-            "  CONST jointtarget j{} := [[{}],[{}]];",
+            "  LOCAL CONST jointtarget j{} := [[{}],[{}]];",
             k + 1,
             axes.join(","),
             external(j.track)
@@ -129,7 +127,7 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
             .unwrap_or([0, 0, 0, 0]);
         let _ = writeln!(
             w,
-            "  CONST robtarget p{} := [{},[{},{},{},{}],[{}]];",
+            "  LOCAL CONST robtarget p{} := [{},[{},{},{},{}],[{}]];",
             k + 1,
             pose_parts(&c.pose),
             conf[0],
@@ -152,16 +150,21 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
                 fine,
                 ..
             } => {
-                let time = duration.map_or(String::new(), |t| format!("\\T:={}", num(t, 3)));
+                // A move of no length has no time to give.
+                let speed = match duration {
+                    None => "vhome".to_string(),
+                    Some(t) if *t < 0.001 => "vjoint".to_string(),
+                    Some(t) => format!("vjoint\\T:={}", num(*t, 3)),
+                };
                 format!(
-                    "MoveAbsJ j{}, vjoint{time}, {}, {}\\WObj:=wall1;",
+                    "MoveAbsJ j{}, {speed}, {}, {}\\WObj:=wall1;",
                     target + 1,
                     if *fine { "fine" } else { free_zone },
                     tools[tcp.as_str()]
                 )
             }
             Instr::Carriage { target, tcp } => format!(
-                "MoveAbsJ j{}, vtrack, fine, {}\\WObj:=wall1;",
+                "MoveAbsJ j{}, vjoint, fine, {}\\WObj:=wall1;",
                 target + 1,
                 tools[tcp.as_str()]
             ),
@@ -182,6 +185,10 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
             }
             Instr::AwaitInput(signal) => format!("WaitDI {}, 1;", signals[signal]),
             Instr::Wait(seconds) => format!("WaitTime {};", num(*seconds, 3)),
+            Instr::OperatorStop(message) => {
+                let _ = writeln!(w, "    TPWrite \"{message}\";");
+                "Stop;".to_string()
+            }
         };
         let _ = writeln!(w, "    {line}");
     }

@@ -76,7 +76,14 @@ pub enum Instr {
     },
     AwaitInput(SignalRole),
     Wait(f64),
+    /// The program stops for the operator: a piece was fed that the cell does not build
+    /// (it lies at the sensor's end stop); the message says what to do.
+    OperatorStop(&'static str),
 }
+
+/// What the operator is asked at a piece that was fed but not framed (within RAPID's 80
+/// characters for `TPWrite`).
+pub const TAKE_OFF_PIECE: &str = "framewright: take the piece off the end stop, then start";
 
 /// The program of one wall.
 #[derive(Debug, Clone, Default)]
@@ -102,6 +109,8 @@ pub struct RoutineInput<'a> {
     pub wall_in_cell: Isometry3<f64>,
     /// The pieces the simulation framed.
     pub framed: &'a BTreeSet<String>,
+    /// The pieces that reached the touch sensor.
+    pub fed: &'a BTreeSet<String>,
     /// Why each other piece was not framed (its first reason), by id.
     pub reasons: &'a BTreeMap<String, String>,
 }
@@ -145,6 +154,16 @@ pub fn routine(input: &RoutineInput) -> Routine {
                 let (comment, keep) = begin_comment(owner, input, &fired, &skipped, &mut out);
                 kept = keep;
                 out.body.push(Instr::Comment(comment));
+                // A piece fed to the sensor and then not framed lies at the end stop: the
+                // operator takes it off before the arm goes on (the next wait for the sensor
+                // would pass on it).
+                if let StepFor::Piece(id) = owner
+                    && !keep
+                    && input.fed.contains(id)
+                {
+                    out.body.push(Instr::AwaitInput(SignalRole::PartPresent));
+                    out.body.push(Instr::OperatorStop(TAKE_OFF_PIECE));
+                }
             }
             RobotStep::Joint {
                 q,
@@ -196,21 +215,25 @@ pub fn routine(input: &RoutineInput) -> Routine {
                 tcps.insert(current_tcp.clone());
                 let target = out.joints.len() - 1;
                 // The run's first step puts the arm at its home pose: a joint move there
-                // from wherever the arm stands, in the controller's own time.
-                out.body.push(if start {
-                    Instr::Joint {
+                // from wherever the arm stands, in the controller's own time; the jaws open
+                // and the nailer off, whatever an aborted run left them.
+                if start {
+                    out.body.push(Instr::Joint {
                         target,
                         speed: input.cell.motion.transfer_speed,
                         duration: None,
                         tcp: current_tcp.clone(),
                         fine: true,
-                    }
+                    });
+                    out.body.push(set(SignalRole::NailerFire, false));
+                    out.body.push(set(SignalRole::GripperClose, false));
+                    out.body.push(set(SignalRole::GripperOpen, true));
                 } else {
-                    Instr::Carriage {
+                    out.body.push(Instr::Carriage {
                         target,
                         tcp: current_tcp.clone(),
-                    }
-                });
+                    });
+                }
             }
             RobotStep::Grip if kept => {
                 out.body.push(set(SignalRole::GripperOpen, false));

@@ -151,7 +151,12 @@ pub mod rapid {
             let (n, s) = it.next().ok_or_else(|| eof("ENDMODULE"))?;
             match word(s).as_str() {
                 "ENDMODULE" if s.len() == 9 => break n,
-                "CONST" | "PERS" | "VAR" => {
+                "CONST" | "PERS" | "VAR" | "LOCAL" => {
+                    // `LOCAL` keeps a module's data out of the task's other modules.
+                    let s = match word(s).as_str() {
+                        "LOCAL" => s[5..].trim_start(),
+                        _ => s,
+                    };
                     let d = parse_decl(n, s)?;
                     if m.decl(&d.name).is_some() {
                         return Err(err(n, "duplicate declaration", s));
@@ -471,6 +476,10 @@ pub mod krl {
             seconds: f64,
             line: usize,
         },
+        /// `HALT`: the program stops until the operator starts it again.
+        Halt {
+            line: usize,
+        },
     }
 
     /// A `.dat` file: `DEFDAT name [PUBLIC] ... ENDDAT`.
@@ -606,7 +615,8 @@ pub mod krl {
         let approx = words.get(2).map(|a| a.to_string());
         let point = || check_var(words[1]).map(|()| words[1].to_string());
         match upper.iter().map(String::as_str).collect::<Vec<_>>()[..] {
-            ["PTP", _] | ["PTP", _, "C_PTP" | "C_DIS"] => Ok(Stmt::Ptp {
+            // PTP blends with C_PTP (`C_DIS` alone is not PTP's criterion).
+            ["PTP", _] | ["PTP", _, "C_PTP"] => Ok(Stmt::Ptp {
                 target: point()?,
                 approx,
                 line: n,
@@ -628,6 +638,7 @@ pub mod krl {
                     line: n,
                 })
             }
+            ["HALT"] => Ok(Stmt::Halt { line: n }),
             ["WAIT", "SEC", _] => match lex_number(words[2]) {
                 Some((seconds, len)) if len == words[2].len() && seconds >= 0.0 => {
                     Ok(Stmt::WaitSec { seconds, line: n })
@@ -778,7 +789,7 @@ ENDMODULE
     const SRC: &str = "&ACCESS RVP\n&REL 1\nDEF fw_w1( )\n  ; comment\n  $TOOL = TOOL_GRIP
   $LOAD.M = 42.5\n  $LOAD.CM = LOAD_CM\n  $BASE = BASE_WALL\n  $VEL_AXIS[1] = 100
   $ACC_AXIS[1] = 100\n  $VEL_EXTAX[1] = 100\n  $VEL.CP = 0.25\n  $ACC.CP = 1.0\n  $APO.CDIS = 5
-  PTP XJ1 C_DIS\n  LIN XP1\n  LIN XP2 C_DIS\n  WAIT FOR $IN[1]\n  WAIT SEC 0.5
+  PTP XJ1 C_PTP\n  LIN XP1\n  LIN XP2 C_DIS\n  WAIT FOR $IN[1]\n  WAIT SEC 0.5
   $OUT[2] = FALSE\nEND\n";
 
     const DAT: &str = "&ACCESS RVP\n&REL 1\nDEFDAT fw_w1\n  ; comment
@@ -864,7 +875,7 @@ ENDMODULE
         let body: Vec<String> = src.body.iter().map(|s| format!("{s:?}")).collect();
         let expected = [
             r#"Assign { lhs: "$VEL_AXIS[1]", rhs: "100", line: 9 }"#,
-            r#"Ptp { target: "XJ1", approx: Some("C_DIS"), line: 15 }"#,
+            r#"Ptp { target: "XJ1", approx: Some("C_PTP"), line: 15 }"#,
             r#"Lin { target: "XP1", approx: None, line: 16 }"#,
             r#"Lin { target: "XP2", approx: Some("C_DIS"), line: 17 }"#,
             r#"WaitFor { condition: "$IN[1]", line: 18 }"#,
@@ -959,7 +970,8 @@ ENDMODULE
             ("LIN XP1\n", "LIN XP1 C_PTP\n", lin),
             ("LIN XP1\n", "LIN XPé\n", lin),
             ("LIN XP1\n", "&REL 2\n", lin),
-            ("LIN XP1\n", "HALT\n", lin),
+            ("LIN XP1\n", "BRAKE\n", lin),
+            ("LIN XP1\n", "PTP XP1 C_DIS\n", lin),
             ("$OUT[2] = FALSE", "$OUT[2] == FALSE", lin + 4),
             ("WAIT SEC 0.5", "WAIT SEC x", lin + 3),
             ("END\n", "END\nDEF b()\nEND\n", lin + 6),
