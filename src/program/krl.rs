@@ -11,7 +11,6 @@ use super::text::{comment_text, num};
 use super::{ProgramFile, WallProgram};
 use crate::cell::io::Signal;
 use nalgebra::Isometry3;
-use std::collections::BTreeMap;
 use std::fmt::Write;
 
 /// The signal numbers the program uses where the cell's `[io]` gives none.
@@ -32,13 +31,16 @@ pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
         name,
         ..
     } = program;
-    let signals = signal_numbers(program)?;
-    let tools: BTreeMap<&str, String> = routine
-        .tcps
-        .iter()
-        .enumerate()
-        .map(|(k, tcp)| (tcp.as_str(), format!("TOOL{}", k + 1)))
-        .collect();
+    let signals = program.signals(|role, given| match given {
+        None => Ok(default_signal(role)),
+        Some(Signal::Number(n)) => Ok(*n),
+        Some(Signal::Name(name)) => Err(format!(
+            "[io] {} = {name:?} is a RAPID signal name; a KRL program needs a signal number (e.g. {})",
+            role.key(),
+            default_signal(role)
+        )),
+    })?;
+    let tools = program.tool_names("TOOL");
     // KUKA tool frames and loads are given in the flange frame (x out of the flange); the
     // tool file's TCPs are in tool0.
     let flange_to_tool0 = flange_to_tool0(program);
@@ -207,32 +209,6 @@ fn flange_to_tool0(program: &WallProgram) -> Isometry3<f64> {
         Some(flange) => flange.inverse() * robot.fk_tip(&q),
         None => Isometry3::identity(),
     }
-}
-
-/// The `$OUT`/`$IN` number of every signal the routine uses.
-fn signal_numbers(program: &WallProgram) -> Result<BTreeMap<SignalRole, i64>, String> {
-    let io = &program.cell.io;
-    program
-        .routine
-        .signals
-        .iter()
-        .map(|&role| {
-            let given = io
-                .signals()
-                .into_iter()
-                .find(|(key, _)| *key == role.key())
-                .and_then(|(_, s)| s);
-            match given {
-                None => Ok((role, default_signal(role))),
-                Some(Signal::Number(n)) => Ok((role, *n)),
-                Some(Signal::Name(name)) => Err(format!(
-                    "[io] {} = {name:?} is a RAPID signal name; a KRL program needs a signal number (e.g. {})",
-                    role.key(),
-                    default_signal(role)
-                )),
-            }
-        })
-        .collect()
 }
 
 /// `X …,Y …,Z …,A …,B …,C …` in mm and degrees, rotation = Rz(A)·Ry(B)·Rx(C).

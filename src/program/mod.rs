@@ -65,6 +65,37 @@ pub struct WallProgram<'a> {
 }
 
 impl WallProgram<'_> {
+    /// The data name of each TCP the routine uses: `prefix1`, `prefix2`, … in TCP-name order.
+    pub fn tool_names(&self, prefix: &str) -> BTreeMap<&str, String> {
+        self.routine
+            .tcps
+            .iter()
+            .enumerate()
+            .map(|(k, tcp)| (tcp.as_str(), format!("{prefix}{}", k + 1)))
+            .collect()
+    }
+
+    /// Each signal the routine uses as the cell's `[io]` gives it (None: not given), made a
+    /// language's signal by `pick` (Err: the other language's kind).
+    pub fn signals<T>(
+        &self,
+        pick: impl Fn(routine::SignalRole, Option<&crate::cell::io::Signal>) -> Result<T, String>,
+    ) -> Result<BTreeMap<routine::SignalRole, T>, String> {
+        let io = &self.cell.io;
+        self.routine
+            .signals
+            .iter()
+            .map(|&role| {
+                let given = io
+                    .signals()
+                    .into_iter()
+                    .find(|(key, _)| *key == role.key())
+                    .and_then(|(_, s)| s);
+                pick(role, given).map(|signal| (role, signal))
+            })
+            .collect()
+    }
+
     /// The header comment's lines.
     pub fn header_lines(&self) -> Vec<String> {
         let r = &self.routine;

@@ -9,7 +9,6 @@ use super::text::{comment_text, num};
 use super::{ProgramFile, WallProgram};
 use crate::cell::io::Signal;
 use nalgebra::{Isometry3, UnitQuaternion};
-use std::collections::BTreeMap;
 use std::fmt::Write;
 
 /// An external axis a target leaves alone.
@@ -33,13 +32,16 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
         name,
         ..
     } = program;
-    let signals = signal_names(program)?;
-    let tools: BTreeMap<&str, String> = routine
-        .tcps
-        .iter()
-        .enumerate()
-        .map(|(k, tcp)| (tcp.as_str(), format!("tool{}", k + 1)))
-        .collect();
+    let signals = program.signals(|role, given| match given {
+        None => Ok(default_signal(role).to_string()),
+        Some(Signal::Name(name)) => Ok(name.clone()),
+        Some(Signal::Number(n)) => Err(format!(
+            "[io] {} = {n} is a KRL signal number; a RAPID program needs a signal name (e.g. {:?})",
+            role.key(),
+            default_signal(role)
+        )),
+    })?;
+    let tools = program.tool_names("tool");
     let speeds = line_speeds(routine);
     let zone = cell.motion.free_zone * 1000.0;
     let mut out = String::new();
@@ -198,32 +200,6 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
         file_name: format!("{name}.mod"),
         text: out,
     })
-}
-
-/// The RAPID name of every signal the routine uses.
-fn signal_names(program: &WallProgram) -> Result<BTreeMap<SignalRole, String>, String> {
-    let io = &program.cell.io;
-    program
-        .routine
-        .signals
-        .iter()
-        .map(|&role| {
-            let given = io
-                .signals()
-                .into_iter()
-                .find(|(key, _)| *key == role.key())
-                .and_then(|(_, s)| s);
-            match given {
-                None => Ok((role, default_signal(role).to_string())),
-                Some(Signal::Name(name)) => Ok((role, name.clone())),
-                Some(Signal::Number(n)) => Err(format!(
-                    "[io] {} = {n} is a KRL signal number; a RAPID program needs a signal name (e.g. {:?})",
-                    role.key(),
-                    default_signal(role)
-                )),
-            }
-        })
-        .collect()
 }
 
 /// The distinct speeds of the routine's straight moves, in order of first use.
