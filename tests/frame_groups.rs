@@ -6,6 +6,9 @@
 //!   as mixed;
 //! - only the untouched wall keeps its group's id.
 
+mod common;
+
+use common::wall_holding;
 use regex::Regex;
 use serde_json::Value;
 use std::path::Path;
@@ -60,22 +63,6 @@ fn with_members(a: &Aggregation, members: &[String]) -> String {
 fn global_id(ifc: &str, id: &str) -> String {
     let re = Regex::new(&format!(r"(?m)^{id}=IFC\w+\('([^']*)'")).unwrap();
     re.captures(ifc).expect("entity")[1].to_string()
-}
-
-/// The plan's wall holding the member with this GlobalId.
-fn wall_holding<'p>(plan: &'p Value, member: &str) -> &'p Value {
-    plan["walls"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| {
-            w["member_ids"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .any(|m| m == member)
-        })
-        .expect("a wall holds the member")
 }
 
 #[test]

@@ -270,26 +270,21 @@ fn bad_ids_and_tuples_exit_2_with_a_clear_message() {
     );
 }
 
-/// The wall of TM3's top plate as `plan` names it: `Wall 1 (W1)`.
+/// The wall of TM3's top plate as `plan` names it: `Wall 1 (W1)` (planned once).
 fn top_plate_wall() -> String {
-    let plan: serde_json::Value =
-        serde_json::from_str(&ok(&["plan", tm3().to_str().unwrap(), "--json"])).unwrap();
-    let wall = plan["walls"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| {
-            w["member_ids"]
-                .as_array()
-                .unwrap()
-                .contains(&serde_json::json!("32H5oapRpM57uELNCcVku8"))
+    static LABEL: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    LABEL
+        .get_or_init(|| {
+            let plan: serde_json::Value =
+                serde_json::from_str(&ok(&["plan", tm3().to_str().unwrap(), "--json"])).unwrap();
+            let wall = common::wall_holding(&plan, "32H5oapRpM57uELNCcVku8");
+            format!(
+                "{} ({})",
+                wall["name"].as_str().unwrap(),
+                wall["wall_id"].as_str().unwrap()
+            )
         })
-        .expect("the top plate is in a wall");
-    format!(
-        "{} ({})",
-        wall["name"].as_str().unwrap(),
-        wall["wall_id"].as_str().unwrap()
-    )
+        .clone()
 }
 
 #[test]

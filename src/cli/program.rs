@@ -60,20 +60,14 @@ pub fn run(args: ProgramArgs) -> CmdResult {
     // Every file is made before any is written: a bad `[io]` writes nothing.
     let walls = programs(&sim, &report, &cell, &name, args.format)?;
     let mut summary = String::new();
-    for files in &walls {
-        write_files(&args.out, files)?;
-        let names: Vec<&str> = files.iter().map(|f| f.file_name.as_str()).collect();
+    for wall in &walls {
+        write_files(&args.out, &wall.files)?;
+        let first = &wall.files[0].file_name;
         let _ = writeln!(
             summary,
             "{}: {}",
-            args.out.join(names[0]).display(),
-            files[0]
-                .text
-                .lines()
-                .find_map(|l| l
-                    .trim_start_matches([' ', '!', ';'])
-                    .strip_prefix("pieces framed: "))
-                .map_or_else(String::new, |counts| format!("pieces framed: {counts}"))
+            args.out.join(first).display(),
+            wall.counts
         );
     }
     leave_to_exit((model, sim, report));

@@ -52,6 +52,14 @@ pub struct ProgramFile {
     pub text: String,
 }
 
+/// One wall's program as written: its files and what it keeps and leaves out.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WallFiles {
+    pub files: Vec<ProgramFile>,
+    /// `pieces framed: N (left out: K); nails fired: …`
+    pub counts: String,
+}
+
 /// One wall's program before it is written in a language.
 pub struct WallProgram<'a> {
     pub routine: Routine,
@@ -98,16 +106,12 @@ impl WallProgram<'_> {
 
     /// The header comment's lines.
     pub fn header_lines(&self) -> Vec<String> {
-        let r = &self.routine;
         let mut lines = vec![format!(
             "framewright {} robot program",
             env!("CARGO_PKG_VERSION")
         )];
         lines.extend(self.about.iter().cloned());
-        lines.push(format!(
-            "pieces framed: {} (left out: {}); nails fired: {} (left out: {})",
-            r.pieces_framed, r.pieces_left_out, r.nails_fired, r.nails_left_out
-        ));
+        lines.push(self.routine.counts());
         lines.push(
             "Exact: the sequence and every target, as simulated and checked (targets in the wall frame; mm, degrees)."
                 .into(),
@@ -130,7 +134,7 @@ pub fn programs(
     cell: &Cell,
     model_name: &str,
     language: Language,
-) -> Result<Vec<Vec<ProgramFile>>, ProgramError> {
+) -> Result<Vec<WallFiles>, ProgramError> {
     let framed: BTreeSet<String> = report
         .elements
         .iter()
@@ -195,7 +199,10 @@ pub fn programs(
             Language::Rapid => vec![rapid::module(&program).map_err(ProgramError::Signal)?],
             Language::Krl => krl::files(&program).map_err(ProgramError::Signal)?.to_vec(),
         };
-        out.push(files);
+        out.push(WallFiles {
+            files,
+            counts: program.routine.counts(),
+        });
     }
     Ok(out)
 }

@@ -146,7 +146,6 @@ pub fn routine(input: &RoutineInput) -> Routine {
     let mut carriage = track.then_some(0.0);
     let mut kept = true;
     let mut fire_pending = false;
-    let mut tcps = BTreeSet::new();
     for step in &input.record.program {
         match step {
             RobotStep::Begin(owner) => {
@@ -175,7 +174,6 @@ pub fn routine(input: &RoutineInput) -> Routine {
                     q: q.clone(),
                     track: carriage,
                 });
-                tcps.insert(tcp.clone());
                 current_tcp = tcp.clone();
                 out.body.push(Instr::Joint {
                     target: out.joints.len() - 1,
@@ -196,7 +194,6 @@ pub fn routine(input: &RoutineInput) -> Routine {
                     q: q.clone(),
                     track: carriage,
                 });
-                tcps.insert(tcp.clone());
                 current_tcp = tcp.clone();
                 out.body.push(Instr::Line {
                     target: out.carts.len() - 1,
@@ -212,7 +209,6 @@ pub fn routine(input: &RoutineInput) -> Routine {
                     q: q.clone(),
                     track: carriage,
                 });
-                tcps.insert(current_tcp.clone());
                 let target = out.joints.len() - 1;
                 // The run's first step puts the arm at its home pose: a joint move there
                 // from wherever the arm stands, in the controller's own time; the jaws open
@@ -267,16 +263,30 @@ pub fn routine(input: &RoutineInput) -> Routine {
         out.body.push(set(SignalRole::NailerFire, false));
     }
     mark_fine_points(&mut out.body);
+    let mut tcps = BTreeSet::new();
     for instr in &out.body {
         match instr {
             Instr::Set { signal, .. } | Instr::AwaitInput(signal) => {
                 out.signals.insert(*signal);
+            }
+            Instr::Joint { tcp, .. } | Instr::Line { tcp, .. } | Instr::Carriage { tcp, .. } => {
+                tcps.insert(tcp.clone());
             }
             _ => {}
         }
     }
     out.tcps = tcps.into_iter().collect();
     out
+}
+
+impl Routine {
+    /// What the routine keeps and leaves out, as its header says it.
+    pub fn counts(&self) -> String {
+        format!(
+            "pieces framed: {} (left out: {}); nails fired: {} (left out: {})",
+            self.pieces_framed, self.pieces_left_out, self.nails_fired, self.nails_left_out
+        )
+    }
 }
 
 fn set(signal: SignalRole, on: bool) -> Instr {

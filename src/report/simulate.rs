@@ -324,6 +324,8 @@ impl SimReport {
         let mut elements = Vec::new();
         for rec in &sim.records {
             let wall = sim.scene.walls.iter().find(|w| w.id == rec.wall);
+            let grips: BTreeMap<&str, f64> =
+                rec.grips.iter().map(|(p, g)| (p.as_str(), *g)).collect();
             for id in wall.map(|w| w.pieces.as_slice()).unwrap_or_default() {
                 let stage = |which: &str, statuses: &BTreeMap<String, String>| ElementStage {
                     status: statuses.get(id).cloned().unwrap_or_default(),
@@ -337,7 +339,7 @@ impl SimReport {
                     wall_id: wall_id(&rec.wall),
                     panel_id: panel_id(&rec.wall),
                     role: sim.plan.roles.get(id).cloned().unwrap_or_default(),
-                    grip_offset: rec.grips.iter().find(|(p, _)| p == id).map(|(_, g)| r6(*g)),
+                    grip_offset: grips.get(id.as_str()).map(|g| r6(*g)),
                     framing: stage("framing", &framing),
                     nailing: stage("nailing", &nailing),
                     rule_findings: Vec::new(),

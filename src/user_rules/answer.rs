@@ -6,7 +6,7 @@
 
 use super::why::{Verdict, WhyReport};
 use crate::logic::Value;
-use crate::logic::provenance::{Explanation, How, Premise};
+use crate::logic::provenance::{Explanation, How};
 use serde::Serialize;
 use std::collections::BTreeSet;
 
@@ -109,44 +109,34 @@ fn rule_of(e: &Explanation) -> String {
 }
 
 /// The simulation facts (inputs with a simulation origin) a tree rests on, first seen first.
-fn evidence(e: &Explanation, out: &mut Vec<String>, seen: &mut BTreeSet<String>) {
-    match &e.how {
-        How::Input { origin } if matches!(origin, crate::logic::Origin::Event(_)) => {
+fn evidence(e: &Explanation) -> Vec<String> {
+    let (mut out, mut seen) = (Vec::new(), BTreeSet::new());
+    super::why::walk(e, &mut |node| {
+        if let How::Input { origin } = &node.how
+            && matches!(origin, crate::logic::Origin::Event(_))
+        {
             let line = format!(
                 "{}  [{}]",
-                super::render::fact(e),
-                super::render::origin_text(&e.relation, &e.tuple, origin)
+                super::render::fact(node),
+                super::render::origin_text(&node.relation, &node.tuple, origin)
             );
             if seen.insert(line.clone()) {
                 out.push(line);
             }
         }
-        How::Rule { premises, .. } => {
-            for p in premises {
-                if let Premise::Tuple(t) = p {
-                    evidence(t, out, seen);
-                }
-            }
-        }
-        _ => {}
-    }
+    });
+    out
 }
 
 /// The first tuple of `relation` in a tree.
 fn find<'e>(e: &'e Explanation, relation: &str) -> Option<&'e Explanation> {
-    if e.relation == relation {
-        return Some(e);
-    }
-    if let How::Rule { premises, .. } = &e.how {
-        for p in premises {
-            if let Premise::Tuple(t) = p
-                && let Some(f) = find(t, relation)
-            {
-                return Some(f);
-            }
+    let mut found = None;
+    super::why::walk(e, &mut |node| {
+        if found.is_none() && node.relation == relation {
+            found = Some(node);
         }
-    }
-    None
+    });
+    found
 }
 
 /// Builds the answer from a report's verdicts.
@@ -245,8 +235,7 @@ fn cause(
     rule: String,
     nail: Option<NailReason>,
 ) -> Cause {
-    let mut lines = Vec::new();
-    evidence(&v.explanation, &mut lines, &mut BTreeSet::new());
+    let mut lines = evidence(&v.explanation);
     lines.truncate(EVIDENCE);
     Cause {
         stage: stage.to_string(),

@@ -340,7 +340,8 @@ pub fn sources_of(e: &Explanation) -> Sources {
     s
 }
 
-fn walk(e: &Explanation, f: &mut impl FnMut(&Explanation)) {
+/// Visits every derived node of a tree depth first, premises in order.
+pub(super) fn walk<'e>(e: &'e Explanation, f: &mut impl FnMut(&'e Explanation)) {
     f(e);
     if let How::Rule { premises, .. } = &e.how {
         for p in premises {

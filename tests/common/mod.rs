@@ -56,3 +56,19 @@ pub fn synth_block(dir: &Path, args: &[&str]) -> PathBuf {
     );
     path
 }
+
+/// The wall of `plan --json` whose members include `member` (a piece id or GlobalId).
+pub fn wall_holding<'p>(plan: &'p serde_json::Value, member: &str) -> &'p serde_json::Value {
+    plan["walls"]
+        .as_array()
+        .expect("the plan's walls")
+        .iter()
+        .find(|w| {
+            w["member_ids"]
+                .as_array()
+                .expect("a wall's members")
+                .iter()
+                .any(|m| m == member)
+        })
+        .expect("a wall holds the member")
+}
