@@ -43,6 +43,8 @@ enum Command {
     World(cli::world::WorldArgs),
     /// Simulate the framing and nailing of every wall and print the verdicts.
     Simulate(cli::simulate::SimulateArgs),
+    /// Simulate the model on several cells and set their figures side by side (the bid).
+    Compare(cli::compare::CompareArgs),
     /// Write the simulated assembly as robot programs (ABB RAPID or KUKA KRL), per wall.
     Program(cli::program::ProgramArgs),
     /// Run user shop rules (violation/warning) over the model's relations.
@@ -72,6 +74,7 @@ fn main() -> ExitCode {
         Command::Synth(args) => cli::synth::run(args),
         Command::World(args) => cli::world::run(args),
         Command::Simulate(args) => cli::simulate::run(args),
+        Command::Compare(args) => cli::compare::run(args),
         Command::Program(args) => cli::program::run(args),
         Command::Check(args) => cli::check::run(args),
         Command::Why(args) => cli::why::run_why(args),

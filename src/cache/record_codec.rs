@@ -7,7 +7,8 @@
 use crate::cell::IkFailure;
 use crate::sim::WallRecord;
 use crate::sim::record::{
-    BeltEvent, ContactRecord, IkRecord, NailOutcome, NailRecord, Operation, Placement,
+    BeltEvent, ContactRecord, IkRecord, NailOutcome, NailRecord, Operation, Placement, Refusal,
+    RefusalKind,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
@@ -24,7 +25,7 @@ pub struct Entry {
 }
 
 /// The entry format; entries of another format are misses.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
 
 impl Entry {
     pub fn new(key: &str, record: &WallRecord) -> Entry {
@@ -92,6 +93,18 @@ fn float(b: u64) -> f64 {
     f64::from_bits(b)
 }
 
+fn refusals_bits(list: &[(String, Refusal)]) -> Vec<(String, RefusalKind, String)> {
+    list.iter()
+        .map(|(p, r)| (p.clone(), r.kind, r.message.clone()))
+        .collect()
+}
+
+fn refusals(list: Vec<(String, RefusalKind, String)>) -> Vec<(String, Refusal)> {
+    list.into_iter()
+        .map(|(p, kind, message)| (p, Refusal { kind, message }))
+        .collect()
+}
+
 #[derive(Serialize, Deserialize)]
 struct Rec {
     wall: String,
@@ -100,8 +113,8 @@ struct Rec {
     contacts: Vec<(String, String, u64, String, String, u64)>,
     placements: Vec<(String, u64, u64)>,
     fed: Vec<(String, u64)>,
-    not_fed: Vec<(String, String)>,
-    grip_failed: Vec<(String, String)>,
+    not_fed: Vec<(String, RefusalKind, String)>,
+    grip_failed: Vec<(String, RefusalKind, String)>,
     grips: Vec<(String, u64)>,
     nails: Vec<NailBits>,
     belt_events: Vec<(u64, String, String, String)>,
@@ -266,8 +279,8 @@ impl From<&WallRecord> for Rec {
                 .map(|p| (p.piece.clone(), bits(p.position_error), bits(p.angle_error)))
                 .collect(),
             fed: r.fed.iter().map(|(p, t)| (p.clone(), bits(*t))).collect(),
-            not_fed: r.not_fed.clone(),
-            grip_failed: r.grip_failed.clone(),
+            not_fed: refusals_bits(&r.not_fed),
+            grip_failed: refusals_bits(&r.grip_failed),
             grips: r.grips.iter().map(|(p, g)| (p.clone(), bits(*g))).collect(),
             nails: r
                 .nails
@@ -386,8 +399,8 @@ impl Rec {
                 })
                 .collect(),
             fed: self.fed.into_iter().map(|(p, t)| (p, float(t))).collect(),
-            not_fed: self.not_fed,
-            grip_failed: self.grip_failed,
+            not_fed: refusals(self.not_fed),
+            grip_failed: refusals(self.grip_failed),
             grips: self.grips.into_iter().map(|(p, g)| (p, float(g))).collect(),
             nails: self
                 .nails
@@ -476,7 +489,10 @@ mod tests {
                 angle_error: 3.0e-7,
             }],
             fed: vec![("p1".into(), 2.5)],
-            not_fed: vec![("p3".into(), "too long".into())],
+            not_fed: vec![(
+                "p3".into(),
+                Refusal::new(RefusalKind::TooLongForConveyors, "too long"),
+            )],
             grip_failed: vec![],
             grips: vec![("p1".into(), -0.25)],
             nails: vec![NailRecord {

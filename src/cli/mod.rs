@@ -5,6 +5,7 @@ pub mod annotate;
 pub mod bcf;
 pub mod cache;
 pub mod check;
+pub mod compare;
 pub mod diff;
 pub mod inspect;
 pub mod plan;

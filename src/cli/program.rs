@@ -51,10 +51,7 @@ pub fn run(args: ProgramArgs) -> CmdResult {
             .map_or(RuleEngine::Compiled, RuleEngine::Directory),
         ..SimOptions::default()
     };
-    let name = args.model.file_name().map_or_else(
-        || args.model.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
+    let name = super::diff::file_name(&args.model);
     let sim = simulate_with_progress(&model, &name, &cell, &options, &|_, _, _| {})?;
     let report = SimReport::new(&sim, options.dt);
     // Every file is made before any is written: a bad `[io]` writes nothing.

@@ -4,12 +4,14 @@
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::load_cell;
 use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
-use framewright::cache::{Need, Shard, simulate_cached_for, simulate_shard};
+use framewright::cache::{Cache, CacheCounts, Need, Shard, simulate_cached_for, simulate_shard};
+use framewright::cell::Cell;
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
+use framewright::report::bid::Bid;
 use framewright::report::html::{ReportInput, write_report};
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, Stepping, simulate_with_progress};
+use framewright::sim::{SimOptions, Simulation, Stepping, simulate_with_progress};
 use framewright::user_rules::UserRules;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
@@ -90,10 +92,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     } else {
         Some(UserRules::load(&args.rules, &options.engine)?)
     };
-    let name = args.model.file_name().map_or_else(
-        || args.model.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
+    let name = super::diff::file_name(&args.model);
     let bars = Bars::new();
     let progress = |wall: &str, done, total| bars.update(wall, done, total);
     let cache = args.cache.open();
@@ -114,17 +113,15 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         warn_if_unwritable(Some(cache));
         return super::cache::print_shard(&run, args.json);
     }
-    let (sim, counts) = match &cache {
-        Some(cache) => {
-            let (sim, counts) =
-                simulate_cached_for(need, &model, &name, &cell, &options, cache, &progress)?;
-            (sim, Some(counts))
-        }
-        None => (
-            simulate_with_progress(&model, &name, &cell, &options, &progress)?,
-            None,
-        ),
-    };
+    let (sim, counts) = simulate_through(
+        need,
+        &model,
+        &name,
+        &cell,
+        &options,
+        cache.as_ref(),
+        &progress,
+    )?;
     bars.finish();
     warn_if_unwritable(cache.as_ref());
     let mut report = SimReport::new(&sim, options.dt);
@@ -148,20 +145,44 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     let written = if args.json {
         write_stdout(|out| report.write_json(out))
     } else {
-        print_stdout(&report.to_terminal(args.verbose))
+        let totals = Bid::new(&sim, &report, &cell).totals_text();
+        print_stdout(&format!("{}{totals}", report.to_terminal(args.verbose)))
     };
     leave_to_exit((model, sim, report));
     written
 }
 
+/// Simulates through the cache when there is one (counting its hits), else afresh.
+pub(super) fn simulate_through(
+    need: Need,
+    model: &Model,
+    name: &str,
+    cell: &Cell,
+    options: &SimOptions,
+    cache: Option<&Cache>,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<(Simulation, Option<CacheCounts>), Failure> {
+    Ok(match cache {
+        Some(cache) => {
+            let (sim, counts) =
+                simulate_cached_for(need, model, name, cell, options, cache, progress)?;
+            (sim, Some(counts))
+        }
+        None => (
+            simulate_with_progress(model, name, cell, options, progress)?,
+            None,
+        ),
+    })
+}
+
 /// One progress bar per wall on a terminal (stderr); nothing otherwise.
-struct Bars {
+pub(super) struct Bars {
     multi: Option<MultiProgress>,
     bars: Mutex<BTreeMap<String, ProgressBar>>,
 }
 
 impl Bars {
-    fn new() -> Bars {
+    pub(super) fn new() -> Bars {
         let multi = std::io::stderr()
             .is_terminal()
             .then(|| MultiProgress::with_draw_target(ProgressDrawTarget::stderr()));
@@ -171,7 +192,7 @@ impl Bars {
         }
     }
 
-    fn update(&self, wall: &str, done: usize, total: usize) {
+    pub(super) fn update(&self, wall: &str, done: usize, total: usize) {
         let Some(multi) = &self.multi else {
             return;
         };
@@ -191,7 +212,7 @@ impl Bars {
         bar.set_position(done as u64);
     }
 
-    fn finish(&self) {
+    pub(super) fn finish(&self) {
         if let Ok(bars) = self.bars.lock() {
             for bar in bars.values() {
                 bar.finish_and_clear();

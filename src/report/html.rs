@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 /// Walls drawn on the index page itself; more get a page each.
 pub const WALLS_PER_PAGE: usize = 8;
 
-const STYLE: &str = r#"
+pub(super) const STYLE: &str = r#"
 body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 960px; }
 table { border-collapse: collapse; margin: 0.5em 0 1em; font-size: 13px; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; }
@@ -115,6 +115,8 @@ pub fn report_files_within(
         "Simulation report",
         html! {
             (header(input))
+            h2 { "Summary" }
+            (super::bid_html::summary_table(&[super::bid::Bid::new(input.sim, input.report, input.cell)]))
             (results_table(&walls, split.then_some(&page_name), &scene_name))
             @if split {
                 @for w in &walls { (causes(w)) }
@@ -413,6 +415,13 @@ fn remove_dead_staging(parent: &Path, name: &str) {
 /// swapped into place (an existing `dir` is replaced only once the new one is complete).
 pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
     let files = report_files_within(input, max_report_bytes()?)?;
+    write_folder(dir, &files)
+}
+
+/// Writes `files` (name, bytes) as the folder `dir`: built in a fresh temporary folder beside
+/// it, then swapped into place. An existing `dir` is replaced only when it holds an earlier
+/// report (an `index.html`) or nothing.
+pub fn write_folder(dir: &Path, files: &[(String, Vec<u8>)]) -> std::io::Result<()> {
     let parent = match dir.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -428,7 +437,7 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
     let _ = std::fs::remove_dir_all(&tmp);
     let result = (|| {
         std::fs::create_dir(&tmp)?;
-        for (file, bytes) in &files {
+        for (file, bytes) in files {
             // Synced before the folder is renamed into place, so a crash cannot expose empty files.
             let mut f = std::fs::File::create(tmp.join(file))?;
             std::io::Write::write_all(&mut f, bytes)?;

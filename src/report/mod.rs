@@ -1,7 +1,10 @@
 //! Outputs a person or a program reads. Numbers in JSON are rounded to the
 //! nanometre so that output is stable and free of float noise.
 
+pub mod bid;
+pub mod bid_html;
 pub mod causes;
+pub mod failure_class;
 pub mod glb;
 pub mod html;
 pub mod inspect;

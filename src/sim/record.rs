@@ -80,6 +80,43 @@ pub enum NailOutcome {
     },
 }
 
+/// Why a piece was never fed or never held: what kind of limit it met (for counting causes,
+/// e.g. in a bid) and the one-line message with the numbers (the verdict's reason).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Refusal {
+    pub kind: RefusalKind,
+    pub message: String,
+}
+
+/// The limits a piece can meet before the arm moves it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RefusalKind {
+    /// Longer than a conveyor carries.
+    TooLongForConveyors,
+    /// The belts did not bring it to the sensor.
+    NotFed,
+    /// The tool has no gripper.
+    NoGripper,
+    /// Thicker or thinner than the jaws open and close.
+    OutsideJawRange,
+    /// Shorter than the distance between the two grippers.
+    ShorterThanGripperSpacing,
+    /// It toppled onto its wide face at the end stop.
+    Toppled,
+    /// It was not where the jaws closed on it.
+    Slipped,
+}
+
+impl Refusal {
+    pub fn new(kind: RefusalKind, message: impl Into<String>) -> Refusal {
+        Refusal {
+            kind,
+            message: message.into(),
+        }
+    }
+}
+
 /// A belt starting or stopping.
 #[derive(Debug, Clone, Serialize)]
 pub struct BeltEvent {
@@ -98,8 +135,10 @@ pub struct WallRecord {
     pub contacts: Vec<ContactRecord>,
     pub placements: Vec<Placement>,
     pub fed: Vec<(String, f64)>,
-    pub not_fed: Vec<(String, String)>,
-    pub grip_failed: Vec<(String, String)>,
+    /// Pieces the belts did not bring to the sensor, and why.
+    pub not_fed: Vec<(String, Refusal)>,
+    /// Pieces the gripper could not take (or lost), and why.
+    pub grip_failed: Vec<(String, Refusal)>,
     pub nails: Vec<NailRecord>,
     pub belt_events: Vec<BeltEvent>,
     /// Where the grip TCP held each placed piece: metres along the piece from its centre,
@@ -391,14 +430,14 @@ impl WallRecord {
         for (p, why) in &self.not_fed {
             facts.add(
                 "sim_not_fed",
-                vec![s(p), s(why)],
+                vec![s(p), s(&why.message)],
                 event(&format!("{p} not fed")),
             );
         }
         for (p, why) in &self.grip_failed {
             facts.add(
                 "sim_grip_failed",
-                vec![s(p), s(why)],
+                vec![s(p), s(&why.message)],
                 event(&format!("grip of {p}")),
             );
         }

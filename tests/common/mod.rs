@@ -5,6 +5,7 @@
 
 pub mod arm;
 pub mod bcf;
+pub mod browser;
 pub mod ifc_edit;
 pub mod python;
 pub mod skip;

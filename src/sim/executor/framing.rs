@@ -5,7 +5,7 @@ use super::{Held, WallRun, failure_score, raise};
 use crate::cell::{Arrangement, IkFailure};
 use crate::sim::motion::LinearMove;
 use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
-use crate::sim::record::{IkRecord, RobotStep, StepFor};
+use crate::sim::record::{IkRecord, Refusal, RefusalKind, RobotStep, StepFor};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
@@ -66,7 +66,9 @@ impl<'a> WallRun<'a> {
         let fed = self.await_piece(piece);
         self.end(&piece.id, "feed", start);
         if let Err(why) = fed {
-            self.record.not_fed.push((piece.id.clone(), why));
+            self.record
+                .not_fed
+                .push((piece.id.clone(), Refusal::new(RefusalKind::NotFed, why)));
             self.take_off(&piece.id);
             return;
         }
@@ -90,7 +92,10 @@ impl<'a> WallRun<'a> {
         {
             self.record.grip_failed.push((
                 piece.id.clone(),
-                "it toppled over at the end stop of conveyor 2 (it lies on its wide face); the gripper takes lumber standing on edge".into(),
+                Refusal::new(
+                    RefusalKind::Toppled,
+                    "it toppled over at the end stop of conveyor 2 (it lies on its wide face); the gripper takes lumber standing on edge",
+                ),
             ));
             self.take_off(&piece.id);
             return;
@@ -179,9 +184,12 @@ impl<'a> WallRun<'a> {
             self.end(id, "pick", start);
             self.record.grip_failed.push((
                 id.to_string(),
-                format!(
-                    "the piece was {:.0} mm from where the jaws closed on it",
-                    offset * 1000.0
+                Refusal::new(
+                    RefusalKind::Slipped,
+                    format!(
+                        "the piece was {:.0} mm from where the jaws closed on it",
+                        offset * 1000.0
+                    ),
                 ),
             ));
             self.take_off(id);
@@ -328,45 +336,55 @@ impl<'a> WallRun<'a> {
 
     /// Whether the conveyors can carry the piece: no longer than conveyor 2, nor than
     /// conveyor 1's deck is wide (side by side) or its belt long (end to end).
-    pub(super) fn carry_check(&self, piece: &ScenePiece) -> Result<(), String> {
+    pub(super) fn carry_check(&self, piece: &ScenePiece) -> Result<(), Refusal> {
         let length = piece.size[0];
         let c2 = self.cell.conveyor2.length;
         let (c1, extent) = match self.cell.arrangement {
             Arrangement::SideBySide => (self.cell.conveyor1.width, "wide"),
             Arrangement::EndToEnd => (self.cell.conveyor1.length, "long"),
         };
+        let too_long = |message: String| Refusal::new(RefusalKind::TooLongForConveyors, message);
         if length > c2 + 1e-9 {
-            return Err(format!(
+            return Err(too_long(format!(
                 "the conveyors cannot carry it: it is {length:.2} m long, conveyor 2 is {c2:.2} m long"
-            ));
+            )));
         }
         if length > c1 + 1e-9 {
-            return Err(format!(
+            return Err(too_long(format!(
                 "the conveyors cannot carry it: it is {length:.2} m long, conveyor 1 is {c1:.2} m {extent}"
-            ));
+            )));
         }
         Ok(())
     }
 
     /// Whether the gripper can take the piece: jaws across its thickness, both grippers on it.
-    pub(super) fn grip_check(&self, piece: &ScenePiece) -> Result<(), String> {
+    pub(super) fn grip_check(&self, piece: &ScenePiece) -> Result<(), Refusal> {
         let Some(g) = &self.cell.tool.gripper else {
-            return Err(format!("the tool {} has no gripper", self.cell.tool.name));
+            return Err(Refusal::new(
+                RefusalKind::NoGripper,
+                format!("the tool {} has no gripper", self.cell.tool.name),
+            ));
         };
         let [length, _, thickness] = piece.size;
         if thickness > g.open_width || thickness < g.closed_width {
-            return Err(format!(
-                "its thickness {:.0} mm is outside the jaws' range {:.0}..{:.0} mm",
-                thickness * 1000.0,
-                g.closed_width * 1000.0,
-                g.open_width * 1000.0
+            return Err(Refusal::new(
+                RefusalKind::OutsideJawRange,
+                format!(
+                    "its thickness {:.0} mm is outside the jaws' range {:.0}..{:.0} mm",
+                    thickness * 1000.0,
+                    g.closed_width * 1000.0,
+                    g.open_width * 1000.0
+                ),
             ));
         }
         if length < g.spacing {
-            return Err(format!(
-                "it is {:.0} mm long, shorter than the gripper spacing {:.0} mm: only one gripper would hold it",
-                length * 1000.0,
-                g.spacing * 1000.0
+            return Err(Refusal::new(
+                RefusalKind::ShorterThanGripperSpacing,
+                format!(
+                    "it is {:.0} mm long, shorter than the gripper spacing {:.0} mm: only one gripper would hold it",
+                    length * 1000.0,
+                    g.spacing * 1000.0
+                ),
             ));
         }
         Ok(())
