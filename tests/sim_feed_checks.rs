@@ -1,7 +1,9 @@
 //! Lumber the cell cannot handle is never fed, and its verdict says why: a piece shorter than
-//! the gripper spacing (it used to topple at the end stop, 60 mm long and standing on edge)
-//! and a piece longer than conveyor 2 (a 58 m plate used to fall off the belts' end). The
-//! lengths come from the models' truth sidecars, not from the simulation.
+//! the gripper spacing when the tool rates no gripper to hold a piece alone (it used to topple
+//! at the end stop, 60 mm long and standing on edge), one heavier than a gripper alone holds,
+//! and a piece longer than conveyor 2 (a 58 m plate used to fall off the belts' end). A short
+//! piece the rating allows is held by one gripper, within its moment. The lengths come from
+//! the models' truth sidecars, not from the simulation.
 
 mod common;
 
@@ -44,12 +46,19 @@ fn run(model: &PathBuf, cell: &Cell, walls: &[&str]) -> (Simulation, SimReport) 
     (sim, report)
 }
 
+/// The study cell with its tool's one-gripper rating taken away.
+fn cell_without_one_gripper() -> Cell {
+    let mut cell = Cell::load("study-abb").expect("cell");
+    cell.tool.gripper.as_mut().expect("gripper").one_gripper = None;
+    cell
+}
+
 #[test]
-fn lumber_shorter_than_the_gripper_spacing_is_never_fed_and_says_why() {
+fn lumber_shorter_than_the_gripper_spacing_is_never_fed_without_a_one_gripper_rating() {
     let model = root().join("tests/fixtures/synth_wall_door_window_in.ifc");
     let lengths =
         truth_lengths(&root().join("tests/fixtures/synth_wall_door_window_in.truth.json"));
-    let cell = Cell::load("study-abb").expect("cell");
+    let cell = cell_without_one_gripper();
     let spacing = cell.tool.gripper.as_ref().expect("gripper").spacing;
     let (sim, report) = run(&model, &cell, &[]);
     let record = &sim.records[0];
@@ -102,6 +111,96 @@ fn lumber_shorter_than_the_gripper_spacing_is_never_fed_and_says_why() {
             );
         }
     }
+}
+
+#[test]
+fn short_lumber_is_held_by_one_gripper_within_its_rating() {
+    let model = root().join("tests/fixtures/synth_wall_door_window_in.ifc");
+    let lengths =
+        truth_lengths(&root().join("tests/fixtures/synth_wall_door_window_in.truth.json"));
+    let cell = Cell::load("study-abb").expect("cell");
+    let gripper = cell.tool.gripper.clone().expect("gripper");
+    let one = gripper
+        .one_gripper
+        .expect("the study tool rates one gripper");
+    let (sim, report) = run(&model, &cell, &[]);
+    let record = &sim.records[0];
+    let mass = |id: &str| {
+        sim.scene
+            .pieces
+            .iter()
+            .find(|s| s.id == id)
+            .map(|p| p.mass)
+            .unwrap_or_else(|| panic!("{id} in the scene"))
+    };
+    let mut held_alone = 0;
+    for (id, length) in lengths.iter().filter(|(_, l)| **l < gripper.spacing) {
+        // Long enough for the jaws and light enough: it goes on the belts.
+        assert!(*length >= one.min_length && mass(id) <= one.max_mass);
+        assert!(
+            record.fed.iter().any(|(p, _)| p == id),
+            "{id} ({length} m) was not fed: {}",
+            report.to_text()
+        );
+        if let Some((_, grip)) = record.grips.iter().find(|(p, _)| p == id) {
+            // The TCP lies half the spacing off the gripper that held it; that gripper's
+            // centre lies `off` from the piece's centre of mass.
+            let off = (grip - gripper.spacing / 2.0)
+                .abs()
+                .min((grip + gripper.spacing / 2.0).abs());
+            assert!(
+                off <= (length - one.min_length) / 2.0 + 1e-6,
+                "{id}: jaws {off} m off the centre of a {length} m piece"
+            );
+            assert!(mass(id) * 9.81 * off <= one.max_moment + 1e-9, "{id}");
+            held_alone += 1;
+        }
+    }
+    assert!(
+        held_alone >= 1,
+        "the fixture's 508 mm plate is held by one gripper: {}",
+        report.to_text()
+    );
+}
+
+#[test]
+fn a_short_piece_heavier_than_one_gripper_holds_is_never_fed_and_says_the_numbers() {
+    let model = root().join("tests/fixtures/synth_wall_door_window_in.ifc");
+    let lengths =
+        truth_lengths(&root().join("tests/fixtures/synth_wall_door_window_in.truth.json"));
+    let mut cell = Cell::load("study-abb").expect("cell");
+    let gripper = cell.tool.gripper.as_mut().expect("gripper");
+    let spacing = gripper.spacing;
+    let one = gripper.one_gripper.as_mut().expect("rated");
+    one.max_mass = 0.5;
+    let (sim, report) = run(&model, &cell, &[]);
+    let record = &sim.records[0];
+    let mut refused = 0;
+    for (id, length) in lengths.iter().filter(|(_, l)| **l < spacing) {
+        let piece = sim
+            .scene
+            .pieces
+            .iter()
+            .find(|p| &p.id == id)
+            .expect("piece");
+        if piece.mass <= 0.5 {
+            continue;
+        }
+        assert!(!record.fed.iter().any(|(p, _)| p == id), "{id} was fed");
+        let element = report
+            .elements
+            .iter()
+            .find(|e| &e.id == id)
+            .expect("verdict");
+        let message = &element.framing.reasons[0].message;
+        assert!(
+            message.contains(&format!("weighs {:.1} kg", piece.mass))
+                && message.contains("one gripper holds at most 0.5 kg"),
+            "{id} ({length} m): {message}"
+        );
+        refused += 1;
+    }
+    assert!(refused >= 1, "the 508 mm plate weighs more than 0.5 kg");
 }
 
 #[test]

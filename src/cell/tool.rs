@@ -50,6 +50,12 @@ struct GripperFile {
     jaw_depth: f64,
     max_lumber: String,
     max_lumber_section: [f64; 2],
+    #[serde(default)]
+    one_gripper_max_mass: Option<f64>,
+    #[serde(default)]
+    one_gripper_max_moment: Option<f64>,
+    #[serde(default)]
+    one_gripper_min_length: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -97,6 +103,21 @@ pub struct Gripper {
     pub max_lumber: String,
     /// Thickness and width of that lumber.
     pub max_lumber_section: [f64; 2],
+    /// What one gripper alone may hold (a piece shorter than the spacing); none: such pieces
+    /// are refused.
+    pub one_gripper: Option<OneGripper>,
+}
+
+/// The rated limits of one gripper holding a piece on its own.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct OneGripper {
+    /// Heaviest piece, kg.
+    pub max_mass: f64,
+    /// Largest moment of the piece's weight about the jaws (its centre of mass off the
+    /// gripper's centre), N·m.
+    pub max_moment: f64,
+    /// Shortest piece the jaws hold square, m (about the jaws' length along the piece).
+    pub min_length: f64,
 }
 
 impl Gripper {
@@ -287,7 +308,35 @@ impl Tool {
                         ),
                     ));
                 }
+                let one_gripper = match (
+                    g.one_gripper_max_mass,
+                    g.one_gripper_max_moment,
+                    g.one_gripper_min_length,
+                ) {
+                    (None, None, None) => None,
+                    (Some(max_mass), Some(max_moment), Some(min_length))
+                        if [max_mass, max_moment]
+                            .iter()
+                            .all(|v| positive(*v) && *v <= 1e4)
+                            && positive(min_length)
+                            && min_length < g.spacing =>
+                    {
+                        Some(OneGripper {
+                            max_mass,
+                            max_moment,
+                            min_length,
+                        })
+                    }
+                    _ => {
+                        return Err(bad(
+                            "gripper",
+                            "one_gripper_max_mass",
+                            "one_gripper_max_mass (kg), one_gripper_max_moment (N m) and one_gripper_min_length (m) go together: give all three, positive, the length below the spacing (or none: pieces shorter than the spacing are refused)".into(),
+                        ));
+                    }
+                };
                 let gripper = Gripper {
+                    one_gripper,
                     count: g.count,
                     spacing: g.spacing,
                     stroke: g.stroke,

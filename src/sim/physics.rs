@@ -229,11 +229,14 @@ pub struct Clearance {
     pub parked: f64,
 }
 
+/// Standard gravity, m/s².
+pub const GRAVITY: f64 = 9.81;
+
 impl Physics {
     /// The cell without lumber; the robot at `q`.
     pub fn new(cell: &Cell, q: &[f64], dt: f64) -> Physics {
         let mut world = PhysicsWorld::new();
-        world.gravity = Vector::new(0.0, 0.0, -9.81);
+        world.gravity = Vector::new(0.0, 0.0, -GRAVITY as f32);
         world.integration_parameters.dt = dt as f32;
         let mut names = HashMap::new();
         let fixed_groups = groups(FIXED, LUMBER | ROBOT);

@@ -100,8 +100,13 @@ pub enum RefusalKind {
     NoGripper,
     /// Thicker or thinner than the jaws open and close.
     OutsideJawRange,
-    /// Shorter than the distance between the two grippers.
+    /// Shorter than the distance between the two grippers (and the tool rates no gripper to
+    /// hold a piece alone).
     ShorterThanGripperSpacing,
+    /// Held by one gripper: shorter than its jaws hold square.
+    TooShortForOneGripper,
+    /// Held by one gripper: heavier than it is rated for, or no grip point within its moment.
+    TooHeavyForOneGripper,
     /// It toppled onto its wide face at the end stop.
     Toppled,
     /// It was not where the jaws closed on it.

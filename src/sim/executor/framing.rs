@@ -4,6 +4,7 @@ use super::paths::distance;
 use super::{Held, WallRun, failure_score, raise};
 use crate::cell::{Arrangement, IkFailure};
 use crate::sim::motion::LinearMove;
+use crate::sim::physics::GRAVITY;
 use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
 use crate::sim::record::{IkRecord, Refusal, RefusalKind, RobotStep, StepFor};
 use crate::world::ScenePiece;
@@ -378,14 +379,39 @@ impl<'a> WallRun<'a> {
             ));
         }
         if length < g.spacing {
-            return Err(Refusal::new(
-                RefusalKind::ShorterThanGripperSpacing,
-                format!(
-                    "it is {:.0} mm long, shorter than the gripper spacing {:.0} mm: only one gripper would hold it",
-                    length * 1000.0,
-                    g.spacing * 1000.0
-                ),
-            ));
+            let Some(one) = g.one_gripper else {
+                return Err(Refusal::new(
+                    RefusalKind::ShorterThanGripperSpacing,
+                    format!(
+                        "it is {:.0} mm long, shorter than the gripper spacing {:.0} mm: only one gripper would hold it, and the tool {} rates none to hold a piece alone",
+                        length * 1000.0,
+                        g.spacing * 1000.0,
+                        self.cell.tool.name
+                    ),
+                ));
+            };
+            if length < one.min_length {
+                return Err(Refusal::new(
+                    RefusalKind::TooShortForOneGripper,
+                    format!(
+                        "it is {:.0} mm long: one gripper holds pieces of {:.0} mm or more square",
+                        length * 1000.0,
+                        one.min_length * 1000.0
+                    ),
+                ));
+            }
+            if piece.mass > one.max_mass {
+                return Err(Refusal::new(
+                    RefusalKind::TooHeavyForOneGripper,
+                    format!(
+                        "it is {:.0} mm long (shorter than the gripper spacing {:.0} mm) and weighs {:.1} kg: one gripper holds at most {:.1} kg",
+                        length * 1000.0,
+                        g.spacing * 1000.0,
+                        piece.mass,
+                        one.max_mass
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -412,13 +438,8 @@ impl<'a> WallRun<'a> {
         // The study grips at the centre of mass; where the arm cannot pick or place a piece
         // gripped there (a long plate whose middle lies far up the belt), the grip moves
         // towards the leading end, the nearest to the centre that works.
-        let spacing = self.cell.tool.gripper.as_ref().map_or(0.0, |g| g.spacing);
-        let furthest = (piece.size[0] / 2.0 - spacing / 2.0 - GRIP_END_MARGIN).max(0.0);
-        let shifts = (0..)
-            .map(|k| k as f64 * GRIP_SHIFT_STEP)
-            .take_while(|s| *s <= furthest + 1e-9);
-        for (shift, flip) in shifts.flat_map(|s| [(s, false), (s, true)]) {
-            if !flip && shift > 0.0 && best.is_some() {
+        for (shift, flip, off_centre) in grip_shifts(piece, self.cell.tool.gripper.as_ref()) {
+            if off_centre && best.is_some() {
                 break;
             }
             let pick = grip_pose(&body, piece, &along, shift, flip);
@@ -517,6 +538,52 @@ impl<'a> WallRun<'a> {
             (None, None) => Err(("place", IkFailure::InvalidPose)),
         }
     }
+}
+
+/// Where along a piece the grip TCP may hold it, nearest the study's grip first: (shift from
+/// the piece's middle towards its leading end, m; tool turned end for end; whether the centre
+/// of mass lies off the grip). Two grippers hold a piece at its centre of mass, or moved
+/// towards either end in steps while both stay on it. A piece shorter than the spacing is held
+/// by one gripper (the TCP half the spacing off the piece's middle, either way): over its
+/// centre of mass, or off it in steps while the jaws stay on the piece and the moment of its
+/// weight stays within the gripper's rating.
+fn grip_shifts(
+    piece: &ScenePiece,
+    gripper: Option<&crate::cell::Gripper>,
+) -> Vec<(f64, bool, bool)> {
+    let length = piece.size[0];
+    let spacing = gripper.map_or(0.0, |g| g.spacing);
+    let one = gripper.and_then(|g| g.one_gripper);
+    let mut shifts = Vec::new();
+    match one {
+        Some(one) if length < spacing => {
+            let furthest = ((length - one.min_length) / 2.0)
+                .min(one.max_moment / (piece.mass.max(1e-9) * GRAVITY));
+            let offsets = (0..)
+                .map(|k| k as f64 * GRIP_SHIFT_STEP)
+                .take_while(|d| *d <= furthest + 1e-9);
+            for d in offsets {
+                for side in [spacing / 2.0, -spacing / 2.0] {
+                    for along in if d > 0.0 { vec![d, -d] } else { vec![0.0] } {
+                        for flip in [false, true] {
+                            shifts.push((side + along, flip, d > 0.0));
+                        }
+                    }
+                }
+            }
+        }
+        _ => {
+            let furthest = (length / 2.0 - spacing / 2.0 - GRIP_END_MARGIN).max(0.0);
+            let offsets = (0..)
+                .map(|k| k as f64 * GRIP_SHIFT_STEP)
+                .take_while(|s| *s <= furthest + 1e-9);
+            for s in offsets {
+                shifts.push((s, false, s > 0.0));
+                shifts.push((s, true, false));
+            }
+        }
+    }
+    shifts
 }
 
 /// The grip TCP on a piece lying on conveyor 2: on its top face, `shift` from its middle
