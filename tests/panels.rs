@@ -619,9 +619,9 @@ fn a_shop_rule_forbids_breaks_and_the_interpreter_agrees() {
         "break_forbidden(w, m - 1.0, m + 1.0, \"no joint near mid-wall\") :- wall_size(w, l, _, _), m = l / 2.0.\n",
     )
     .unwrap();
-    let plan = plan(&long, &["--rules-dir", shop.to_str().unwrap()]);
-    check_panels(&plan, "shop");
-    let breaks: Vec<f64> = plan["walls"][0]["panel_breaks"]
+    let shop_plan = plan(&long, &["--rules-dir", shop.to_str().unwrap()]);
+    check_panels(&shop_plan, "shop");
+    let breaks: Vec<f64> = shop_plan["walls"][0]["panel_breaks"]
         .as_array()
         .unwrap()
         .iter()
@@ -642,6 +642,85 @@ fn a_shop_rule_forbids_breaks_and_the_interpreter_agrees() {
         before.iter().any(|u| (6.0..=8.0).contains(u)),
         "without the rule a break lies near mid-wall ({before:?}): the rule must change something"
     );
+    // The same file given with --rules joins the built-in rules: the same panels.
+    let with_rules = plan(&long, &["--rules", shop.join("shop.dl").to_str().unwrap()]);
+    assert_eq!(with_rules["walls"], shop_plan["walls"]);
+    // So it does for simulate: its panels are those breaks' panels.
+    let sim = |extra: &[&str]| -> Value {
+        let m = long.to_str().unwrap();
+        let out = framewright(&[&["simulate", m, "--json", "--no-cache"][..], extra].concat());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let ids = |v: &Value| -> Vec<String> {
+        v["walls"][0]["panels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| format!("{}:{}", p["panel_id"], p["u_start"]))
+            .collect()
+    };
+    let shop_sim = sim(&["--rules", shop.join("shop.dl").to_str().unwrap()]);
+    let panel_members = |v: &Value| -> Vec<usize> {
+        v["panels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                v["elements"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .filter(|e| e["panel_id"] == p["panel_id"])
+                    .count()
+            })
+            .collect()
+    };
+    let planned: Vec<usize> = shop_plan["walls"][0]["panels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            p["member_ids"].as_array().unwrap().len()
+                + p["cut_pieces"].as_array().unwrap().len()
+                + p["added_pieces"].as_array().unwrap().len()
+        })
+        .collect();
+    assert_eq!(panel_members(&shop_sim), planned, "{:?}", ids(&shop_plan));
+    // A file that both feeds the rule base and reports findings is refused, naming both.
+    let mixed = dir.path().join("mixed.dl");
+    std::fs::write(
+        &mixed,
+        "break_forbidden(w, 0.0, 1.0, \"no joint at the start\") :- wall_size(w, _, _, _).\nwarning(w, \"w\", \"m\") :- wall_size(w, _, _, _).\n",
+    )
+    .unwrap();
+    let out = framewright(&[
+        "plan",
+        long.to_str().unwrap(),
+        "--rules",
+        mixed.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("break_forbidden") && err.contains("warning") && err.contains("two files"),
+        "{err}"
+    );
+    // With a rule base of one's own, such a file belongs in it.
+    let out = framewright(&[
+        "plan",
+        long.to_str().unwrap(),
+        "--rules-dir",
+        rules.to_str().unwrap(),
+        "--rules",
+        shop.join("shop.dl").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("put the file in that directory"));
 }
 
 fn stdout_of(args: &[&str]) -> String {

@@ -40,8 +40,8 @@ pub struct AnnotateArgs {
 
 pub fn run(args: AnnotateArgs) -> CmdResult {
     let inputs = &args.inputs;
-    let (model, cell, facts) = load_inputs(&args.model, inputs)?;
     let engine = rule_base(&inputs.rules_dir);
+    let (model, cell, facts) = load_inputs(&args.model, inputs, &engine)?;
     let (plan, verdicts) = if args.simulate {
         let options = SimOptions {
             walls: args.walls.clone(),

@@ -10,7 +10,7 @@ use framewright::frame::{Facts, RuleEngine, model_facts, reason};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::sim::{SimOptions, simulate};
-use framewright::user_rules::{Finding, Findings, UserRules};
+use framewright::user_rules::{Finding, Findings, UserRules, engine_for};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -99,9 +99,10 @@ pub fn load_cell(name: &str, offset_x: Option<&str>) -> Result<Cell, Failure> {
 pub fn load_inputs(
     model: &Path,
     inputs: &ReasoningInputs,
+    engine: &RuleEngine,
 ) -> Result<(Model, Cell, Facts), Failure> {
     let (model, cell, mut facts) = load_model_facts(model, inputs)?;
-    add_placement_facts(&mut facts, &cell, &rule_base(&inputs.rules_dir))?;
+    add_placement_facts(&mut facts, &cell, engine)?;
     Ok((model, cell, facts))
 }
 
@@ -134,6 +135,16 @@ pub fn rule_base(rules_dir: &Option<PathBuf>) -> RuleEngine {
         .map_or(RuleEngine::Compiled, RuleEngine::Directory)
 }
 
+/// The rule base to reason with and the `--rules` files that report findings: a file that
+/// feeds the rule base (a shop hook such as `break_forbidden`) joins it
+/// (`user_rules::engine_for`).
+pub fn rules_in_force(
+    rules_dir: &Option<PathBuf>,
+    rules: &[PathBuf],
+) -> Result<(RuleEngine, Vec<PathBuf>), Failure> {
+    Ok(engine_for(rules, &rule_base(rules_dir))?)
+}
+
 #[derive(Serialize)]
 struct Report<'a> {
     model: String,
@@ -154,9 +165,9 @@ struct Row<'a> {
 }
 
 pub fn run(args: CheckArgs) -> CmdResult {
-    let base = rule_base(&args.inputs.rules_dir);
     // Rule files first: a typo fails before the model is read.
-    let user = UserRules::load(&args.rules, &base)?;
+    let (base, findings_files) = rules_in_force(&args.inputs.rules_dir, &args.rules)?;
+    let user = UserRules::load(&findings_files, &base)?;
     if args.simulate {
         args.inputs
             .tolerance_for_executor("leave out --simulate to check the plan with this tolerance")?;
@@ -173,7 +184,7 @@ pub fn run(args: CheckArgs) -> CmdResult {
         let findings = user.evaluate(&sim.reasoned.relations)?;
         return report(&args, &model, &cell.name, &findings);
     }
-    let (model, cell, facts) = load_inputs(&args.model, &args.inputs)?;
+    let (model, cell, facts) = load_inputs(&args.model, &args.inputs, &base)?;
     let reasoned = reason(&facts, &base, false)?;
     let findings = user.evaluate(&reasoned.relations)?;
     report(&args, &model, &cell.name, &findings)

@@ -4,12 +4,12 @@
 //! independent part of the model, so a plan after a small edit reasons only what changed.
 
 use super::cache::{CacheArgs, warn_if_unwritable};
-use super::check::{ReasoningInputs, load_model_facts, rule_base};
-use super::{CmdResult, leave_to_exit, print_stdout, write_stdout};
+use super::check::{ReasoningInputs, load_model_facts, rules_in_force};
+use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::reason_plan_cached_with;
-use framewright::frame::RuleLimits;
 use framewright::frame::placement::reason_placed;
 use framewright::frame::plan::Plan;
+use framewright::frame::{RuleEngine, RuleLimits};
 use framewright::report::plan::PlanReport;
 use framewright::report::role_check::{RoleCheck, Truth};
 use std::path::PathBuf;
@@ -27,6 +27,11 @@ pub struct PlanArgs {
     /// --rules-dir).
     #[command(flatten)]
     pub cache: CacheArgs,
+    /// A shop rule file that feeds the rule base (it derives into a hook no built-in rule
+    /// derives, such as `break_forbidden` or `break_wanted`): it joins the built-in rules, run
+    /// on the interpreter. Repeat for more. (Findings rules run with `check`.)
+    #[arg(long = "rules", value_name = "FILE.dl")]
+    pub rules: Vec<PathBuf>,
     /// A hand-labelled truth file (JSON `{"members": [{"id", "role"}, …]}`, e.g. a `synth
     /// --truth` sidecar): also print each role's precision and recall against it.
     #[arg(long, value_name = "FILE")]
@@ -37,10 +42,17 @@ pub fn run(args: PlanArgs) -> CmdResult {
     let inputs = &args.inputs;
     // A bad truth file is refused before any work.
     let truth = args.truth.as_deref().map(Truth::read).transpose()?;
+    let (engine, findings_files) = rules_in_force(&inputs.rules_dir, &args.rules)?;
+    if let Some(f) = findings_files.first() {
+        return Err(Failure::bad_input(format!(
+            "{}: plan runs no findings rules (violation/warning); run this file with `framewright check --rules`",
+            f.display()
+        )));
+    }
     let (model, cell, facts) = load_model_facts(&args.model, inputs)?;
-    let cache = match inputs.rules_dir {
-        None => args.cache.open(),
-        Some(_) => None,
+    let cache = match engine {
+        RuleEngine::Compiled => args.cache.open(),
+        _ => None,
     };
     let limits = RuleLimits::from_env()?;
     let (reasoned, counts, plan) = match &cache {
@@ -53,7 +65,6 @@ pub fn run(args: PlanArgs) -> CmdResult {
             (reasoned, Some(counts), plan)
         }
         None => {
-            let engine = rule_base(&inputs.rules_dir);
             let reasoned = reason_placed(facts, &cell, &engine, Plan::RELATIONS, &limits)?;
             let plan = Plan::from_reasoned(&model, &reasoned);
             (reasoned, None, plan)

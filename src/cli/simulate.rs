@@ -2,11 +2,10 @@
 //! nailing of every wall in the physics simulation and prints the verdicts.
 
 use super::cache::{CacheArgs, warn_if_unwritable};
-use super::check::load_cell;
+use super::check::{load_cell, rules_in_force};
 use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::{Cache, CacheCounts, Need, Shard, simulate_cached_for, simulate_shard};
 use framewright::cell::Cell;
-use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::report::bid::Bid;
 use framewright::report::html::{ReportInput, write_report};
@@ -78,19 +77,18 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     let model = Model::open(&args.model)?;
     let mut cell = load_cell(&args.cell, args.offset_x.as_deref())?;
     cell.panel_mode = args.panels.panels;
+    let (engine, findings_files) = rules_in_force(&args.rules_dir, &args.rules)?;
     let options = SimOptions {
         walls: args.walls,
         dt: args.step_ms / 1000.0,
         speed: args.speed,
         stepping: args.stepping,
-        engine: args
-            .rules_dir
-            .map_or(RuleEngine::Compiled, RuleEngine::Directory),
+        engine,
     };
-    let user_rules = if args.rules.is_empty() {
+    let user_rules = if findings_files.is_empty() {
         None
     } else {
-        Some(UserRules::load(&args.rules, &options.engine)?)
+        Some(UserRules::load(&findings_files, &options.engine)?)
     };
     let name = super::diff::file_name(&args.model);
     let bars = Bars::new();

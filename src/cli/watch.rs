@@ -103,11 +103,13 @@ struct Watch {
 pub fn run(args: WatchArgs) -> CmdResult {
     let mut cell = Cell::load(&args.cell)?;
     cell.panel_mode = args.panels.panels;
-    let options = simulate_defaults();
-    let rules = if args.rules.is_empty() {
+    let mut options = simulate_defaults();
+    let (engine, findings_files) = super::check::rules_in_force(&None, &args.rules)?;
+    options.engine = engine;
+    let rules = if findings_files.is_empty() {
         None
     } else {
-        Some(UserRules::load(&args.rules, &options.engine)?)
+        Some(UserRules::load(&findings_files, &options.engine)?)
     };
     let out = args.out.clone().unwrap_or_else(|| {
         let mut name = args.model.as_os_str().to_owned();

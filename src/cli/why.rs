@@ -3,7 +3,7 @@
 //! keys and rule lines; or which rule could have derived a tuple and which
 //! condition failed.
 
-use super::check::{ReasoningInputs, load_inputs, load_model_facts, rule_base};
+use super::check::{ReasoningInputs, load_inputs, load_model_facts, rules_in_force};
 use super::{CmdResult, Failure, print_stdout};
 use framewright::frame::RuleLimits;
 use framewright::frame::containers::{containers_of, restrict_to_containers};
@@ -93,12 +93,12 @@ fn simulate_walls(
     if c.no_simulate {
         return Ok((Vec::new(), None));
     }
-    let base = rule_base(&c.inputs.rules_dir);
+    let (base, user_files) = rules_in_force(&c.inputs.rules_dir, &c.rules)?;
     let ctx = Context {
         model,
         facts,
         base: &base,
-        user_files: &c.rules,
+        user_files: &user_files,
     };
     let mut walls = Vec::new();
     let mut split = false;
@@ -180,7 +180,7 @@ impl Common {
 pub fn run_why(args: WhyArgs) -> CmdResult {
     let c = &args.common;
     c.check_simulation()?;
-    let base = rule_base(&c.inputs.rules_dir);
+    let (base, user_files) = rules_in_force(&c.inputs.rules_dir, &c.rules)?;
     let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
     // The whole model's plan names walls and panels as every other command does.
     let (plan, _) = plan_of(facts.clone(), &cell, &base, &model)?;
@@ -216,7 +216,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,
         base: &base,
-        user_files: &c.rules,
+        user_files: &user_files,
     };
     let mut reports = why(&ctx, &args.id).map_err(failure)?;
     name_walls(&mut reports, &names);
@@ -266,7 +266,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
 pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     let c = &args.common;
     c.check_simulation()?;
-    let base = rule_base(&c.inputs.rules_dir);
+    let (base, user_files) = rules_in_force(&c.inputs.rules_dir, &c.rules)?;
     if let Some(query) = panel_why::parse_break_query(&args.tuple) {
         let (wall, u) = query.map_err(Failure::bad_input)?;
         let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
@@ -275,14 +275,14 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
             .map_err(Failure::bad_input)?;
         return print_panel_answer(c, &args.model, &cell.name, &args.tuple, &answer);
     }
-    let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs)?;
+    let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs, &base)?;
     let ids = piece_ids_in(&model, &args.tuple);
     let (_, panelized) = simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
     let ctx = Context {
         model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,
         base: &base,
-        user_files: &c.rules,
+        user_files: &user_files,
     };
     let report = why_not(&ctx, &args.tuple).map_err(failure)?;
     let text = if c.json {

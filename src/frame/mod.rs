@@ -47,6 +47,9 @@ pub enum RuleEngine {
     Interpreted,
     /// Every `.dl` file of a directory on the interpreter, replacing the built-in rules.
     Directory(PathBuf),
+    /// The built-in rules and shop files that feed them (they derive into relations no
+    /// built-in rule derives, such as `break_forbidden`), on the interpreter.
+    Extended(Vec<PathBuf>),
 }
 
 /// The evaluated rule base: every relation by name. Tuples come in a
@@ -87,6 +90,20 @@ pub fn directory_files(dir: &Path) -> Result<Vec<PathBuf>, FrameError> {
 /// Every `.dl` file of `dir`, sorted, as one program.
 pub fn directory_program(dir: &Path) -> Result<Program, FrameError> {
     Ok(Program::parse_files(&directory_files(dir)?)?)
+}
+
+/// The built-in rules with shop files added (`RuleEngine::Extended`) as one checked program.
+pub fn extended_program(files: &[PathBuf]) -> Result<Program, FrameError> {
+    let sigs = crate::logic::functors::signatures();
+    let mut loader = crate::logic::front::check::Loader::new(&sigs);
+    for (name, text) in crate::logic::compiled::BUILTIN_SOURCES {
+        let dir = Path::new(name).parent().unwrap_or(Path::new("."));
+        loader.load_text(name, text, dir)?;
+    }
+    for f in files {
+        loader.load_file(f, None)?;
+    }
+    Ok(loader.finish()?)
 }
 
 /// Runs the rule base over the facts.
@@ -144,6 +161,7 @@ fn reason_unchecked(
         }
         RuleEngine::Compiled | RuleEngine::Interpreted => Program::builtin()?,
         RuleEngine::Directory(dir) => directory_program(dir)?,
+        RuleEngine::Extended(files) => extended_program(files)?,
     };
     let program = Arc::new(program);
     let mut interpreter = Engine::new(

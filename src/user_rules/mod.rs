@@ -51,6 +51,14 @@ pub enum UserRulesError {
     RulesDir { path: PathBuf, message: String },
     #[error("cannot read rule file {}: {message}; check the path", path.display())]
     RuleFile { path: PathBuf, message: String },
+    #[error("the rule file {} derives into {feeds}, which feed the built-in rules, and reports {reports}: the first run before planning, the second after it; put them in two files", file.display())]
+    FeedsAndFinds {
+        file: PathBuf,
+        feeds: String,
+        reports: String,
+    },
+    #[error("the rule file {} feeds the rule base (a relation no rule of it derives); with --rules-dir {}, put the file in that directory", file.display(), dir.display())]
+    FeedsRulesDir { file: PathBuf, dir: PathBuf },
     #[error("the user rule file {} lies in the rules directory {}, so it would also be read as part of the rule base; keep user rule files outside --rules-dir", file.display(), dir.display())]
     InsideRulesDir { file: PathBuf, dir: PathBuf },
 }
@@ -285,6 +293,88 @@ pub fn full_program(base: &RuleEngine, user_files: &[PathBuf]) -> Result<Program
     Ok(program)
 }
 
+fn load_builtin(loader: &mut Loader<'_>) -> Result<(), UserRulesError> {
+    for (name, text) in BUILTIN_SOURCES {
+        let dir = Path::new(name).parent().unwrap_or(Path::new("."));
+        loader.load_text(name, text, dir)?;
+    }
+    Ok(())
+}
+
+/// Sorts `--rules` files into those that feed the built-in rules (they derive into a relation
+/// the rule base declares and none of its rules derives, a shop hook such as
+/// `break_forbidden`) and the rest (findings rules). The first kind joins the rule base, on
+/// the interpreter (`RuleEngine::Extended`); the engine to reason with and the findings files
+/// come back. A file doing both, or feeding a `--rules-dir` rule base, is refused.
+pub fn engine_for(
+    files: &[PathBuf],
+    base: &RuleEngine,
+) -> Result<(RuleEngine, Vec<PathBuf>), UserRulesError> {
+    check_readable(files)?;
+    check_outside_rules_dir(files, base)?;
+    let base_program = base_program(base)?;
+    refuse_redeclarations(files, &base_program)?;
+    let derived: BTreeSet<&str> = base_program
+        .rules
+        .iter()
+        .map(|r| r.head.rel.as_str())
+        .collect();
+    let sigs = functors::signatures();
+    let mut feeding = Vec::new();
+    let mut findings = Vec::new();
+    for f in files {
+        let mut loader = Loader::new(&sigs);
+        load_base(&mut loader, base)?;
+        loader.load_text(FINDINGS_SOURCE.0, FINDINGS_SOURCE.1, Path::new("."))?;
+        loader.load_file(f, None)?;
+        let program = loader.finish()?;
+        let first_own = base_program.sources.len() + 1;
+        let heads: BTreeSet<&str> = program
+            .rules
+            .iter()
+            .filter(|r| r.span.file as usize >= first_own)
+            .map(|r| r.head.rel.as_str())
+            .collect();
+        let feeds: Vec<&str> = heads
+            .iter()
+            .copied()
+            .filter(|h| base_program.relation(h).is_some() && !derived.contains(h))
+            .collect();
+        let reports: Vec<&str> = heads
+            .iter()
+            .copied()
+            .filter(|h| FINDING_RELATIONS.contains(h))
+            .collect();
+        match (feeds.is_empty(), reports.is_empty()) {
+            (true, _) => findings.push(f.clone()),
+            (false, true) => feeding.push(f.clone()),
+            (false, false) => {
+                return Err(UserRulesError::FeedsAndFinds {
+                    file: f.clone(),
+                    feeds: feeds.join(", "),
+                    reports: reports.join(", "),
+                });
+            }
+        }
+    }
+    if feeding.is_empty() {
+        return Ok((base.clone(), findings));
+    }
+    match base {
+        RuleEngine::Compiled | RuleEngine::Interpreted => {
+            Ok((RuleEngine::Extended(feeding), findings))
+        }
+        RuleEngine::Extended(earlier) => Ok((
+            RuleEngine::Extended(earlier.iter().chain(&feeding).cloned().collect()),
+            findings,
+        )),
+        RuleEngine::Directory(dir) => Err(UserRulesError::FeedsRulesDir {
+            file: feeding[0].clone(),
+            dir: dir.clone(),
+        }),
+    }
+}
+
 fn load_base(loader: &mut Loader<'_>, base: &RuleEngine) -> Result<(), UserRulesError> {
     match base {
         RuleEngine::Directory(dir) => {
@@ -292,10 +382,11 @@ fn load_base(loader: &mut Loader<'_>, base: &RuleEngine) -> Result<(), UserRules
                 loader.load_file(&f, None)?;
             }
         }
-        RuleEngine::Compiled | RuleEngine::Interpreted => {
-            for (name, text) in BUILTIN_SOURCES {
-                let dir = Path::new(name).parent().unwrap_or(Path::new("."));
-                loader.load_text(name, text, dir)?;
+        RuleEngine::Compiled | RuleEngine::Interpreted => load_builtin(loader)?,
+        RuleEngine::Extended(files) => {
+            load_builtin(loader)?;
+            for f in files {
+                loader.load_file(f, None)?;
             }
         }
     }
@@ -441,7 +532,7 @@ fn redefinition(
         )
     } else if feeds_base {
         format!(
-            "`{name}` feeds the built-in rules, which run before user rule files: put this file in a rule base instead (copy `rules/` to a directory, add the file there, and pass `--rules-dir DIR`)"
+            "`{name}` feeds the built-in rules, which run before findings rules: keep such rules in a file of their own (no violation/warning rules), which `--rules` adds to the built-in rules, or put it in a rule base (`--rules-dir DIR`)"
         )
     } else {
         format!(

@@ -131,10 +131,15 @@ fn cache_key(
                 }
             }
         }
-        RuleEngine::Compiled | RuleEngine::Interpreted => {
+        RuleEngine::Compiled | RuleEngine::Interpreted | RuleEngine::Extended(_) => {
             for (name, text) in BUILTIN_SOURCES {
                 name.hash(&mut h);
                 text.hash(&mut h);
+            }
+            if let RuleEngine::Extended(files) = engine {
+                for f in files {
+                    std::fs::read(f).unwrap_or_default().hash(&mut h);
+                }
             }
         }
     }
