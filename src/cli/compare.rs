@@ -7,7 +7,6 @@ use super::check::load_cell;
 use super::simulate::{Bars, simulate_through};
 use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::Need;
-use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::report::bid::{Bid, table_text};
 use framewright::report::bid_html::compare_page;
@@ -71,9 +70,7 @@ pub fn run(args: CompareArgs) -> CmdResult {
     let name = super::diff::file_name(&args.model);
     let options = SimOptions {
         walls: args.walls,
-        engine: args
-            .rules_dir
-            .map_or(RuleEngine::Compiled, RuleEngine::Directory),
+        engine: super::check::rule_base(&args.rules_dir),
         ..SimOptions::default()
     };
     let cache = args.cache.open();

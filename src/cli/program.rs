@@ -4,7 +4,6 @@
 
 use super::check::load_cell;
 use super::{CmdResult, leave_to_exit, print_stdout};
-use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
 use framewright::program::{Language, programs, write_files};
 use framewright::report::simulate::SimReport;
@@ -46,9 +45,7 @@ pub fn run(args: ProgramArgs) -> CmdResult {
     cell.panel_mode = args.panels.panels;
     let options = SimOptions {
         walls: args.walls,
-        engine: args
-            .rules_dir
-            .map_or(RuleEngine::Compiled, RuleEngine::Directory),
+        engine: super::check::rule_base(&args.rules_dir),
         ..SimOptions::default()
     };
     let name = super::diff::file_name(&args.model);
