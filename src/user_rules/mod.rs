@@ -310,6 +310,10 @@ pub fn engine_for(
     files: &[PathBuf],
     base: &RuleEngine,
 ) -> Result<(RuleEngine, Vec<PathBuf>), UserRulesError> {
+    // Most runs give no rule file: the rule base is not parsed for nothing.
+    if files.is_empty() {
+        return Ok((base.clone(), Vec::new()));
+    }
     check_readable(files)?;
     check_outside_rules_dir(files, base)?;
     let base_program = base_program(base)?;
