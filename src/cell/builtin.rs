@@ -39,6 +39,11 @@ pub(crate) const CELLS: &[(&str, &str, &str)] = &[
         "robots/cells/study-kuka.toml",
         include_str!("../../robots/cells/study-kuka.toml"),
     ),
+    (
+        "framing-line",
+        "robots/cells/framing-line.toml",
+        include_str!("../../robots/cells/framing-line.toml"),
+    ),
 ];
 
 pub fn robot_names() -> Vec<&'static str> {

@@ -128,7 +128,7 @@ impl Robot {
     fn reach_check(&self, target: &Isometry3<f64>) -> Option<IkFailure> {
         let first = *self.active.first()?;
         let zero = vec![0.0; self.dof()];
-        let poses = self.fk_all(&zero);
+        let poses = self.fk_all_unmounted(&zero);
         let shoulder = (poses[self.joints[first].parent] * self.joints[first].origin)
             .translation
             .vector;

@@ -166,7 +166,7 @@ impl Robot {
         variants: Variants,
     ) -> Result<Vec<Vec<f64>>, IkFailure> {
         assert_eq!(seed.len(), self.dof(), "seed length");
-        let target = tip_target(pose, tcp)?;
+        let target = tip_target(&(self.mount.inverse() * pose), tcp)?;
         match &self.opw {
             Some(_) => Ok(self
                 .ik_closed_form(&target, seed, options, variants)?
@@ -181,7 +181,7 @@ impl Robot {
     /// (negative: out of reach). `None` for robots without a closed form.
     pub fn reach_margin(&self, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) -> Option<f64> {
         let opw = self.opw.as_ref()?;
-        let target = pose * tcp.inverse();
+        let target = self.mount.inverse() * pose * tcp.inverse();
         let [front, _] = opw.solve(&target, 0.0).shoulder_distance;
         let (min_reach, reach) = opw.shoulder_reach();
         Some((reach - front).min(front - min_reach))
@@ -212,7 +212,7 @@ impl Robot {
         options: &IkOptions,
     ) -> Result<Vec<[f64; 6]>, IkFailure> {
         assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
-        let target = tip_target(pose, tcp)?;
+        let target = tip_target(&(self.mount.inverse() * pose), tcp)?;
         match &self.opw {
             Some(_) => self.ik_closed_form(&target, seed, options, Variants::All),
             None => Ok(self
@@ -248,7 +248,7 @@ impl Robot {
         seed: &[f64; 6],
     ) -> Result<[f64; 6], IkFailure> {
         assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
-        let target = tip_target(pose, tcp)?;
+        let target = tip_target(&(self.mount.inverse() * pose), tcp)?;
         let mut solutions = match &self.opw {
             Some(_) => {
                 let options = IkOptions::default();
@@ -270,7 +270,7 @@ impl Robot {
 
     /// Distance (m) and rotation angle (rad) between the tip at `q` and `target`.
     pub(crate) fn residual(&self, q: &[f64], target: &Isometry3<f64>) -> (f64, f64) {
-        let got = self.fk_tip(q);
+        let got = self.fk_tip_unmounted(q);
         (
             (got.translation.vector - target.translation.vector).norm(),
             got.rotation.angle_to(&target.rotation),

@@ -63,6 +63,21 @@ struct RobotSection {
     base_position: [f64; 3],
     #[serde(default)]
     base_yaw_deg: f64,
+    /// How the robot is mounted: on the floor (default) or inverted (hanging under a gantry).
+    #[serde(default)]
+    mounting: Mounting,
+}
+
+/// `[robot] mounting`: how `base_link` sits at `base_position`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum Mounting {
+    /// z up, as the URDF stands.
+    #[default]
+    Floor,
+    /// Upside down (a half turn about the base's x axis): the arm hangs from a gantry or a
+    /// ceiling. The base frame framewright works in stays z up.
+    Inverted,
 }
 
 #[derive(Debug, Deserialize)]
@@ -123,10 +138,12 @@ impl OffsetX {
                 max: range[1],
             });
         }
+        // Negative: the wall's bottom edge (or start) lies behind the base, as under a robot
+        // hanging over the middle of the table.
         match text.trim().parse::<f64>() {
-            Ok(x) if x.is_finite() && (0.0..=100.0).contains(&x) => Ok(OffsetX::Fixed { x }),
+            Ok(x) if x.is_finite() && (-100.0..=100.0).contains(&x) => Ok(OffsetX::Fixed { x }),
             _ => Err(format!(
-                "expected a distance in m from 0 to 100 or \"auto\", got {text:?}"
+                "expected a distance in m from -100 to 100 or \"auto\", got {text:?}"
             )),
         }
     }
@@ -379,7 +396,8 @@ pub struct Cell {
     /// The file it came from (`robots/cells/<name>.toml` for built-ins).
     pub source: PathBuf,
     pub robot: Robot,
-    /// base_link in the cell frame.
+    /// The robot's base frame in the cell frame: at `base_position`, turned by the yaw, z up.
+    /// `base_link` itself lies at `robot_base * robot.mount()` (turned over when inverted).
     pub robot_base: Isometry3<f64>,
     pub tool: Tool,
     pub assembly: Assembly,
@@ -440,6 +458,12 @@ impl Cell {
         )
     }
 
+    /// The height (cell z) of the surface walls are laid on: `surface_z` is measured from the
+    /// robot's base frame, which a gantry or a pedestal raises off the floor.
+    pub fn surface_height(&self) -> f64 {
+        self.robot_base.translation.z + self.assembly.surface_z
+    }
+
     /// Overrides the cell's `offset_x` (a distance in m, or `auto`), as the command line does.
     pub fn set_offset_x(&mut self, text: &str) -> Result<(), String> {
         self.assembly.offset_x = OffsetX::parse(text, self.assembly.auto_range)?;
@@ -496,8 +520,14 @@ impl Cell {
                     .into_owned()
             }
         };
-        let robot = Robot::load(&resolve(&f.robot.model))
+        let mut robot = Robot::load(&resolve(&f.robot.model))
             .map_err(|e| bad("robot", "model", e.to_string()))?;
+        if f.robot.mounting == Mounting::Inverted {
+            robot.set_mount(Isometry3::from_parts(
+                Translation3::identity(),
+                UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
+            ));
+        }
         let tool =
             Tool::load(&resolve(&f.tool.model)).map_err(|e| bad("tool", "model", e.to_string()))?;
 
@@ -581,7 +611,7 @@ impl Cell {
         coord("conveyor1", "position", &c1.position)?;
         finite_angle("conveyor1", "direction_deg", c1.direction_deg)?;
         size("conveyor1", "length", &[c1.length], 100.0)?;
-        size("conveyor1", "width", &[c1.width], 10.0)?;
+        size("conveyor1", "width", &[c1.width], 100.0)?;
         speed("conveyor1", c1.speed)?;
         if !(c1.lumber_gap.is_finite() && (0.0..=10.0).contains(&c1.lumber_gap)) {
             return Err(bad(
@@ -774,12 +804,20 @@ impl Cell {
             .tcp("grip")
             .ok_or("the tool has no `grip` TCP to pick with")?;
         let home = self.robot.home();
+        // On a track the carriage picks from abeam of the pick point.
+        let (base, carriage) = match &self.track {
+            Some(t) => {
+                let s = t.abeam(&self.pick.point);
+                (t.base_at(s), format!(", carriage at {s:.3} m"))
+            }
+            None => (self.robot_base, String::new()),
+        };
         let mut margins = vec![];
         for &h in heights {
-            let pose = self.to_robot(&self.pick_pose(h));
+            let pose = base.inverse() * self.pick_pose(h);
             let p = pose.translation.vector;
             let at = format!(
-                "pick point ({:.3}, {:.3}, {:.3}) m in the robot frame (lumber height {h} m)",
+                "pick point ({:.3}, {:.3}, {:.3}) m in the robot frame (lumber height {h} m{carriage})",
                 p.x, p.y, p.z
             );
             if let Err(fail) = self.robot.ik(&pose, &tcp, &home) {

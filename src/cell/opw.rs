@@ -58,7 +58,7 @@ impl Opw {
             [2.0, -0.1, 0.9, 1.5, 0.4, 2.5],
         ];
         for q in probes {
-            let urdf = robot.fk_tip(&q);
+            let urdf = robot.fk_tip_unmounted(&q);
             let own = opw.forward(&q);
             let dp = (urdf.translation.vector - own.translation.vector).norm();
             let dr = urdf.rotation.angle_to(&own.rotation);

@@ -108,6 +108,11 @@ pub struct Robot {
     pub tip: usize,
     pub meta: RobotMeta,
     pub(crate) opw: Option<Opw>,
+    /// How `base_link` hangs in the base frame the rest of framewright works in (identity:
+    /// on the floor; a half turn about x: inverted, under a gantry). FK answers and IK takes
+    /// poses in that frame, whose z points up whatever the mounting; the URDF chain and the
+    /// closed form run in `base_link` itself.
+    pub(crate) mount: Isometry3<f64>,
 }
 
 impl Robot {
@@ -151,9 +156,28 @@ impl Robot {
         self.opw.is_some()
     }
 
-    /// Pose of every link in the root frame (`base_link`), in `links` order.
+    /// Mounts the robot: `mount` is `base_link` in the base frame (see [`Robot::mount`]).
+    pub fn set_mount(&mut self, mount: Isometry3<f64>) {
+        self.mount = mount;
+    }
+
+    /// `base_link` in the base frame: identity on the floor, a half turn inverted.
+    pub fn mount(&self) -> Isometry3<f64> {
+        self.mount
+    }
+
+    /// Pose of every link in the base frame (`base_link` as mounted), in `links` order.
     /// Panics if `q.len() != self.dof()` (a programming error, not input).
     pub fn fk_all(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+        let mount = self.mount;
+        self.fk_all_unmounted(q)
+            .into_iter()
+            .map(|pose| mount * pose)
+            .collect()
+    }
+
+    /// Pose of every link in `base_link` itself (the URDF's own frame).
+    pub(crate) fn fk_all_unmounted(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut poses = vec![Isometry3::identity(); self.links.len()];
         for joint in &self.joints {
@@ -163,8 +187,13 @@ impl Robot {
         poses
     }
 
-    /// Pose of the tip link (e.g. `tool0`) in the root frame.
+    /// Pose of the tip link (e.g. `tool0`) in the base frame (`base_link` as mounted).
     pub fn fk_tip(&self, q: &[f64]) -> Isometry3<f64> {
+        self.mount * self.fk_tip_unmounted(q)
+    }
+
+    /// Pose of the tip link in `base_link` itself (what the closed form solves for).
+    pub(crate) fn fk_tip_unmounted(&self, q: &[f64]) -> Isometry3<f64> {
         let mut pose = Isometry3::identity();
         for (i, (origin, j)) in self.tip_steps.iter().enumerate() {
             let joint = &self.joints[*j];
@@ -440,6 +469,7 @@ fn build_tree(path: &Path, urdf: &urdf_rs::Robot, meta: &RobotMeta) -> Result<Ro
         tip,
         meta: meta.clone(),
         opw: None,
+        mount: Isometry3::identity(),
     })
 }
 

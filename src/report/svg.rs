@@ -200,7 +200,7 @@ pub fn reach_radius(cell: &Cell, z: f64) -> Option<f64> {
 pub(super) fn plan_view(cell: &Cell, view: &WallView, thickness: f64) -> Markup {
     let (fx, fy) = (cell.floor.size[0] / 2.0, cell.floor.size[1] / 2.0);
     let base = cell.robot_base.translation.vector;
-    let reach = reach_radius(cell, cell.assembly.surface_z + thickness);
+    let reach = reach_radius(cell, cell.surface_height() + thickness);
     // The drawing covers the cell's equipment, the reach and the wall (not the whole floor).
     let mut extent: Vec<[f64; 2]> = view
         .pieces

@@ -90,13 +90,13 @@ impl<'a> WallRun<'a> {
     ) -> WallRun<'a> {
         let q = cell.robot.home();
         let mut phys = Physics::new(cell, &q, options.dt);
-        if cell.assembly.surface_z > cell.floor.z + SURFACE_ON_FLOOR
+        if cell.surface_height() > cell.floor.z + SURFACE_ON_FLOOR
             && let Some((min, max)) = footprint(&pieces)
         {
             phys.add_assembly_table(
                 [min[0] - TABLE_BORDER, min[1] - TABLE_BORDER],
                 [max[0] + TABLE_BORDER, max[1] + TABLE_BORDER],
-                cell.assembly.surface_z,
+                cell.surface_height(),
             );
         }
         WallRun {
