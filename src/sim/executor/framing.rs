@@ -438,8 +438,8 @@ impl<'a> WallRun<'a> {
         // The study grips at the centre of mass; where the arm cannot pick or place a piece
         // gripped there (a long plate whose middle lies far up the belt), the grip moves
         // towards the leading end, the nearest to the centre that works.
-        for (shift, flip, off_centre) in grip_shifts(piece, self.cell.tool.gripper.as_ref()) {
-            if off_centre && best.is_some() {
+        for (shift, flip, fallback) in grip_shifts(piece, self.cell.tool.gripper.as_ref()) {
+            if fallback && best.is_some() {
                 break;
             }
             let pick = grip_pose(&body, piece, &along, shift, flip);
@@ -491,17 +491,19 @@ impl<'a> WallRun<'a> {
                         LINE_SAMPLES,
                     )
                     .map_err(|f| ("place", f))?;
-                    let blocked = {
-                        let held_in_tool = grip * in_body.inverse();
-                        let half = piece.size.map(|v| v / 2.0);
-                        let held = Some((piece.id.as_str(), &held_in_tool, half));
-                        touches(&self.phys, &at_place, &q_place, held, &[], 0.0).or_else(|| {
-                            touches(&self.phys, &at_pick, &q_pick, None, &[&piece.id], 0.0)
-                        })
-                    };
-                    if let Some((a, b)) = blocked {
-                        // A reachable pose that collides: the closest kind of miss.
+                    // A reachable pose that collides: the closest kind of miss, named by the
+                    // pose it is at (a short piece's front gripper may meet the end stop at
+                    // the pick).
+                    let held_in_tool = grip * in_body.inverse();
+                    let half = piece.size.map(|v| v / 2.0);
+                    let held = Some((piece.id.as_str(), &held_in_tool, half));
+                    if let Some((a, b)) = touches(&self.phys, &at_place, &q_place, held, &[], 0.0) {
                         return Err(("place", IkFailure::AllSolutionsCollide { pair: [a, b] }));
+                    }
+                    if let Some((a, b)) =
+                        touches(&self.phys, &at_pick, &q_pick, None, &[&piece.id], 0.0)
+                    {
+                        return Err(("pick", IkFailure::AllSolutionsCollide { pair: [a, b] }));
                     }
                     Ok::<_, (&'static str, IkFailure)>(FramingPlan {
                         pick_body: body,
@@ -541,9 +543,10 @@ impl<'a> WallRun<'a> {
 }
 
 /// Where along a piece the grip TCP may hold it, nearest the study's grip first: (shift from
-/// the piece's middle towards its leading end, m; tool turned end for end; whether the centre
-/// of mass lies off the grip). Two grippers hold a piece at its centre of mass, or moved
-/// towards either end in steps while both stay on it. A piece shorter than the spacing is held
+/// the piece's middle towards its leading end, m; tool turned end for end; a fallback, tried
+/// only while no grip before it planned). Two grippers hold a piece at its centre of mass, or
+/// moved towards either end in steps while both stay on it; one barely longer than the spacing
+/// falls back on one gripper over its centre of mass. A piece shorter than the spacing is held
 /// by one gripper (the TCP half the spacing off the piece's middle, either way): over its
 /// centre of mass, or off it in steps while the jaws stay on the piece and the moment of its
 /// weight stays within the gripper's rating.
@@ -580,6 +583,19 @@ fn grip_shifts(
             for s in offsets {
                 shifts.push((s, false, s > 0.0));
                 shifts.push((s, true, false));
+            }
+            // A piece barely longer than the spacing puts a jaw at its very end, where it may
+            // meet the end stop at the pick: one gripper over its centre of mass, where the
+            // tool rates it, is the fallback.
+            if let Some(one) = one
+                && furthest < GRIP_SHIFT_STEP
+                && piece.mass <= one.max_mass
+            {
+                for side in [spacing / 2.0, -spacing / 2.0] {
+                    for flip in [false, true] {
+                        shifts.push((side, flip, true));
+                    }
+                }
             }
         }
     }
