@@ -73,7 +73,8 @@ pub fn panel_chart(bids: &[Bid]) -> Markup {
         .fold(0.0f64, f64::max)
         .max(1.0);
     // Labels of up to LABEL_CHARS characters (longer ids keep their end, where the panel's
-    // number is), at about 6 px a character.
+    // number is), at up to 7.5 px a character (ids are mostly capitals and digits, wider than
+    // the average character at the chart's font size).
     const LABEL_CHARS: usize = 28;
     let label = |id: &str| {
         let n = id.chars().count();
@@ -91,7 +92,7 @@ pub fn panel_chart(bids: &[Bid]) -> Markup {
         .map(|id| label(id).chars().count())
         .max()
         .unwrap_or(4);
-    let (label_w, bar_w, bar_h, gap) = (12.0 + 6.0 * widest as f64, 560.0, 9.0, 6.0);
+    let (label_w, bar_w, bar_h, gap) = (12.0 + 7.5 * widest as f64, 560.0, 9.0, 6.0);
     let group_h = bar_h * bids.len() as f64 + gap;
     let height = 24.0 + group_h * order.len() as f64 + 24.0;
     let x = |s: f64| label_w + s / longest * bar_w;
