@@ -166,7 +166,7 @@ impl Robot {
         variants: Variants,
     ) -> Result<Vec<Vec<f64>>, IkFailure> {
         assert_eq!(seed.len(), self.dof(), "seed length");
-        let target = tip_target(&(self.mount.inverse() * pose), tcp)?;
+        let target = self.tip_target(pose, tcp)?;
         match &self.opw {
             Some(_) => Ok(self
                 .ik_closed_form(&target, seed, options, variants)?
@@ -212,7 +212,7 @@ impl Robot {
         options: &IkOptions,
     ) -> Result<Vec<[f64; 6]>, IkFailure> {
         assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
-        let target = tip_target(&(self.mount.inverse() * pose), tcp)?;
+        let target = self.tip_target(pose, tcp)?;
         match &self.opw {
             Some(_) => self.ik_closed_form(&target, seed, options, Variants::All),
             None => Ok(self
@@ -248,7 +248,7 @@ impl Robot {
         seed: &[f64; 6],
     ) -> Result<[f64; 6], IkFailure> {
         assert_eq!(self.dof(), 6, "ik6 needs a 6-axis robot");
-        let target = tip_target(&(self.mount.inverse() * pose), tcp)?;
+        let target = self.tip_target(pose, tcp)?;
         let mut solutions = match &self.opw {
             Some(_) => {
                 let options = IkOptions::default();
@@ -266,6 +266,20 @@ impl Robot {
             }
         };
         Ok(solutions.swap_remove(0))
+    }
+
+    /// The tool0 pose in `base_link` (the mount undone) that puts `tcp` on `pose` (base frame);
+    /// Err(InvalidPose) when either is not finite.
+    fn tip_target(
+        &self,
+        pose: &Isometry3<f64>,
+        tcp: &Isometry3<f64>,
+    ) -> Result<Isometry3<f64>, IkFailure> {
+        let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
+        if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
+            return Err(IkFailure::InvalidPose);
+        }
+        Ok(self.mount.inverse() * pose * tcp.inverse())
     }
 
     /// Distance (m) and rotation angle (rad) between the tip at `q` and `target`.
@@ -533,15 +547,6 @@ fn turn_copies(v: f64, (lo, hi): (f64, f64)) -> ([f64; 4], usize) {
         x += 2.0 * PI;
     }
     (copies, count)
-}
-
-/// The tool0 pose that puts `tcp` on `pose`; Err(InvalidPose) when either is not finite.
-fn tip_target(pose: &Isometry3<f64>, tcp: &Isometry3<f64>) -> Result<Isometry3<f64>, IkFailure> {
-    let finite = |m: nalgebra::Matrix4<f64>| m.iter().all(|v| v.is_finite());
-    if !finite(pose.to_homogeneous()) || !finite(tcp.to_homogeneous()) {
-        return Err(IkFailure::InvalidPose);
-    }
-    Ok(pose * tcp.inverse())
 }
 
 /// Push every copy of `q` shifted by whole turns that fits the limits (all joints revolute).

@@ -397,7 +397,7 @@ pub struct Cell {
     pub source: PathBuf,
     pub robot: Robot,
     /// The robot's base frame in the cell frame: at `base_position`, turned by the yaw, z up.
-    /// `base_link` itself lies at `robot_base * robot.mount()` (turned over when inverted).
+    /// `base_link` itself lies at `robot_base` times the robot's mount (turned over when inverted).
     pub robot_base: Isometry3<f64>,
     pub tool: Tool,
     pub assembly: Assembly,

@@ -156,30 +156,26 @@ impl Robot {
         self.opw.is_some()
     }
 
-    /// Mounts the robot: `mount` is `base_link` in the base frame (see [`Robot::mount`]).
+    /// Mounts the robot: `mount` is `base_link` in the base frame (identity on the floor).
     pub fn set_mount(&mut self, mount: Isometry3<f64>) {
         self.mount = mount;
-    }
-
-    /// `base_link` in the base frame: identity on the floor, a half turn inverted.
-    pub fn mount(&self) -> Isometry3<f64> {
-        self.mount
     }
 
     /// Pose of every link in the base frame (`base_link` as mounted), in `links` order.
     /// Panics if `q.len() != self.dof()` (a programming error, not input).
     pub fn fk_all(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
-        let mount = self.mount;
-        self.fk_all_unmounted(q)
-            .into_iter()
-            .map(|pose| mount * pose)
-            .collect()
+        self.fk_all_from(self.mount, q)
     }
 
     /// Pose of every link in `base_link` itself (the URDF's own frame).
     pub(crate) fn fk_all_unmounted(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+        self.fk_all_from(Isometry3::identity(), q)
+    }
+
+    /// Pose of every link with the root at `root`.
+    fn fk_all_from(&self, root: Isometry3<f64>, q: &[f64]) -> Vec<Isometry3<f64>> {
         assert_eq!(q.len(), self.dof(), "joint vector length");
-        let mut poses = vec![Isometry3::identity(); self.links.len()];
+        let mut poses = vec![root; self.links.len()];
         for joint in &self.joints {
             let value = joint.dof_index.map_or(0.0, |i| q[i]);
             poses[joint.child] = poses[joint.parent] * joint.transform(value);
