@@ -88,6 +88,7 @@ fn study_tool_has_grip_and_nail_frames_and_takes_2x6() {
     assert!((nailer - 4.0).abs() < 1e-9);
     let g = tool.gripper.as_ref().unwrap();
     assert_eq!(g.count, 2);
+    let g = g.jaws().expect("the study's grippers have jaws");
     assert!(g.takes(0.038, 0.140), "2x6");
     assert!(g.takes(0.038, 0.089), "2x4");
     assert!(!g.takes(0.089, 0.184), "4x8 is too wide");
@@ -261,4 +262,67 @@ fn nail_lean_outside_0_to_30_degrees_is_refused() {
             .max_nail_lean,
         0.0
     );
+}
+
+/// The line's tool holds the top face: no jaws, and the keys of each kind of gripper belong to
+/// it alone.
+#[test]
+fn a_gripper_holding_the_top_face_has_pads_and_no_jaws() {
+    use framewright::cell::Hold;
+    let line = include_str!("../robots/tools/line-vacuum-nailer.toml");
+    let tool = Tool::load("line-vacuum-nailer").unwrap();
+    let g = tool.gripper.as_ref().unwrap();
+    assert!(g.jaws().is_none());
+    let Hold::Top(pads) = g.holds else {
+        panic!("the line's tool holds the top face")
+    };
+    // The pads fit the 38 mm face of lumber on edge; the rating holds a 12 m 2x6 plate
+    // (0.038 x 0.140 x 12 m at 500 kg/m3 = 31.9 kg).
+    assert!(pads.pad_width < 0.038);
+    assert!(pads.max_mass > 0.038 * 0.140 * 12.0 * 500.0);
+    // No part of the tool reaches below the grip TCP (the top face of the held piece).
+    let grip_z = tool.tcp("grip").unwrap().translation.z;
+    for part in tool.parts.iter().filter(|p| p.name.starts_with("gripper")) {
+        let framewright::cell::Shape::Box { half_extents } = part.shape.shape else {
+            panic!("{} is a box", part.name)
+        };
+        let bottom = part.shape.origin.translation.z + half_extents[2];
+        assert!(
+            bottom <= grip_z + 1e-9,
+            "{} reaches to z {bottom}",
+            part.name
+        );
+    }
+
+    let bad = |from: &str, to: &str| {
+        let text = line.replace(from, to);
+        assert_ne!(text, line, "{from}");
+        Tool::parse(Path::new("pads.toml"), &text)
+            .unwrap_err()
+            .to_string()
+    };
+    let msg = bad("pad_width = 0.030", "pad_width = 0.030\nopen_width = 0.16");
+    assert!(
+        msg.contains("pads.toml:") && msg.contains("open_width") && msg.contains("top face"),
+        "{msg}"
+    );
+    let msg = bad("pad_width = 0.030", "");
+    assert!(
+        msg.contains("pad_width") && msg.contains("missing"),
+        "{msg}"
+    );
+    let msg = bad("holds = \"top\"", "holds = \"magnet\"");
+    assert!(
+        msg.contains("gripper.holds") && msg.contains("magnet"),
+        "{msg}"
+    );
+    let msg = bad("max_mass = 50.0", "max_mass = -1.0");
+    assert!(msg.contains("gripper.max_mass"), "{msg}");
+    // The study's jaws without their stroke: named, with the kind that needs it.
+    let study = include_str!("../robots/tools/study-gripper-nailer.toml");
+    let text = study.replace("stroke = 0.065", "");
+    let msg = Tool::parse(Path::new("jaws.toml"), &text)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("stroke") && msg.contains("sides"), "{msg}");
 }

@@ -80,9 +80,13 @@ fn the_hanging_robot_reaches_down_to_the_table_in_the_upright_base_frame() {
     assert!(margin > 0.0 && margin < 2.4, "margin {margin}");
 }
 
+/// TM3 has cap plates: laid beside its top plate on the table, a cap covers the entry points of
+/// the nails through the top plate into the studs, and it is set face to face against that
+/// plate. The line drives those nails before the cap goes on, and its grippers hold the cap by
+/// its top face.
 #[test]
-fn the_line_frames_and_nails_every_piece_of_the_study_models_one_and_two() {
-    for model in ["tm1", "tm2"] {
+fn the_line_frames_and_nails_every_piece_of_the_study_models() {
+    for model in ["tm1", "tm2", "tm3"] {
         let truth: Value = serde_json::from_str(
             &std::fs::read_to_string(example(&format!("{model}.truth.json"))).unwrap(),
         )
@@ -96,7 +100,13 @@ fn the_line_frames_and_nails_every_piece_of_the_study_models_one_and_two() {
         );
         for e in elements {
             assert_eq!(e["framing"]["status"], "framed", "{model}: {e}");
-            assert_eq!(e["nailing"]["status"], "nailed", "{model}: {e}");
+            // Every plate and stud is nailed; a cap plate has no nails in the plan.
+            let nailing = &e["nailing"]["status"];
+            if e["role"] == "cap_plate" {
+                assert_eq!(nailing, "none", "{model}: {e}");
+            } else {
+                assert_eq!(nailing, "nailed", "{model}: {e}");
+            }
         }
         // A square frame: two nails through a plate into each end of each stud.
         let studs = truth["counts"]["by_role"]["stud"].as_u64().unwrap();

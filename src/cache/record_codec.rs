@@ -120,6 +120,7 @@ struct Rec {
     belt_events: Vec<(u64, String, String, String)>,
     framing_end: u64,
     nailing_end: u64,
+    nailing_while_framing: u64,
     steps: u64,
 }
 
@@ -336,6 +337,7 @@ impl From<&WallRecord> for Rec {
                 .collect(),
             framing_end: bits(r.framing_end),
             nailing_end: bits(r.nailing_end),
+            nailing_while_framing: bits(r.nailing_while_framing),
             steps: r.steps,
         }
     }
@@ -445,6 +447,7 @@ impl Rec {
             belt_events,
             framing_end: float(self.framing_end),
             nailing_end: float(self.nailing_end),
+            nailing_while_framing: float(self.nailing_while_framing),
             steps: self.steps,
         })
     }
@@ -516,6 +519,7 @@ mod tests {
             }],
             framing_end: 12.75,
             nailing_end: 30.125,
+            nailing_while_framing: 2.5,
             steps: 7200,
         }
     }

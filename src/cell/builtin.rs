@@ -17,11 +17,18 @@ pub(crate) const ROBOTS: &[(&str, &str, &str, &str)] = &[
     ),
 ];
 
-pub(crate) const TOOLS: &[(&str, &str, &str)] = &[(
-    "study-gripper-nailer",
-    "robots/tools/study-gripper-nailer.toml",
-    include_str!("../../robots/tools/study-gripper-nailer.toml"),
-)];
+pub(crate) const TOOLS: &[(&str, &str, &str)] = &[
+    (
+        "study-gripper-nailer",
+        "robots/tools/study-gripper-nailer.toml",
+        include_str!("../../robots/tools/study-gripper-nailer.toml"),
+    ),
+    (
+        "line-vacuum-nailer",
+        "robots/tools/line-vacuum-nailer.toml",
+        include_str!("../../robots/tools/line-vacuum-nailer.toml"),
+    ),
+];
 
 pub(crate) const CELLS: &[(&str, &str, &str)] = &[
     (

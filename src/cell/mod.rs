@@ -34,7 +34,7 @@ pub use meta::{OpwParams, RobotMeta};
 pub use panels::{PanelLimits, PanelMode};
 pub use robot::{Inertial, Joint, JointKind, Link, Robot};
 pub use shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};
-pub use tool::{Gripper, Tool, ToolPart};
+pub use tool::{Gripper, Hold, Jaws, OneGripper, Tool, ToolPart, TopPads};
 pub use track::Track;
 
 use nalgebra::Isometry3;

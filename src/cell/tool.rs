@@ -42,12 +42,17 @@ struct FrameFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct GripperFile {
+    /// "sides" (the default): jaws close on the piece's side faces; "top": pads hold its top face.
+    #[serde(default)]
+    holds: Option<String>,
     count: u32,
     spacing: f64,
-    stroke: f64,
-    open_width: f64,
-    closed_width: f64,
-    jaw_depth: f64,
+    stroke: Option<f64>,
+    open_width: Option<f64>,
+    closed_width: Option<f64>,
+    jaw_depth: Option<f64>,
+    pad_width: Option<f64>,
+    max_mass: Option<f64>,
     max_lumber: String,
     max_lumber_section: [f64; 2],
     #[serde(default)]
@@ -88,17 +93,14 @@ pub struct ToolPart {
     pub shape: PlacedShape,
 }
 
-/// Parallel grippers of a tool (all lengths in m).
+/// The grippers of a tool, spaced along the lumber (all lengths in m).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Gripper {
     pub count: u32,
     /// Distance between gripper centres along the lumber's long axis.
     pub spacing: f64,
-    /// Travel of each jaw.
-    pub stroke: f64,
-    pub open_width: f64,
-    pub closed_width: f64,
-    pub jaw_depth: f64,
+    /// How each gripper holds the piece.
+    pub holds: Hold,
     /// Trade name of the widest lumber taken, e.g. "2x6".
     pub max_lumber: String,
     /// Thickness and width of that lumber.
@@ -106,6 +108,37 @@ pub struct Gripper {
     /// What one gripper alone may hold (a piece shorter than the spacing); none: such pieces
     /// are refused.
     pub one_gripper: Option<OneGripper>,
+}
+
+/// How a gripper holds lumber.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Hold {
+    /// Parallel jaws close on the piece's side faces: a finger goes down each side, so the
+    /// piece cannot be set against a neighbour face to face.
+    Sides(Jaws),
+    /// Pads (vacuum or needles) hold the piece's top face: nothing reaches below it.
+    Top(TopPads),
+}
+
+/// A parallel gripper's jaws (m).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Jaws {
+    /// Travel of each jaw.
+    pub stroke: f64,
+    pub open_width: f64,
+    pub closed_width: f64,
+    /// How far the fingers reach below the palm.
+    pub jaw_depth: f64,
+}
+
+/// Pads holding the top face.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct TopPads {
+    /// The pads' width across the piece: the narrowest top face they hold, m.
+    pub pad_width: f64,
+    /// The heaviest piece all the pads together hold, kg.
+    pub max_mass: f64,
 }
 
 /// The rated limits of one gripper holding a piece on its own.
@@ -121,6 +154,16 @@ pub struct OneGripper {
 }
 
 impl Gripper {
+    /// The jaws, when the gripper holds the piece by its sides.
+    pub fn jaws(&self) -> Option<&Jaws> {
+        match &self.holds {
+            Hold::Sides(j) => Some(j),
+            Hold::Top(_) => None,
+        }
+    }
+}
+
+impl Jaws {
     /// Whether a lumber cross-section (any way up) fits between the open jaws and is held
     /// when they close.
     pub fn takes(&self, thickness: f64, width: f64) -> bool {
@@ -279,86 +322,7 @@ impl Tool {
         }
         let gripper = match file.gripper {
             None => None,
-            Some(g) => {
-                let lengths = [
-                    g.spacing,
-                    g.stroke,
-                    g.open_width,
-                    g.closed_width,
-                    g.jaw_depth,
-                ];
-                if !lengths
-                    .iter()
-                    .chain(&g.max_lumber_section)
-                    .all(|v| positive(*v) && *v <= 10.0)
-                {
-                    return Err(bad(
-                        "gripper",
-                        "spacing",
-                        "gripper lengths must be positive and at most 10 m".into(),
-                    ));
-                }
-                if g.closed_width >= g.open_width {
-                    return Err(bad(
-                        "gripper",
-                        "closed_width",
-                        format!(
-                            "closed width {} must be smaller than the open width {}",
-                            g.closed_width, g.open_width
-                        ),
-                    ));
-                }
-                let one_gripper = match (
-                    g.one_gripper_max_mass,
-                    g.one_gripper_max_moment,
-                    g.one_gripper_min_length,
-                ) {
-                    (None, None, None) => None,
-                    (Some(max_mass), Some(max_moment), Some(min_length))
-                        if [max_mass, max_moment]
-                            .iter()
-                            .all(|v| positive(*v) && *v <= 1e4)
-                            && positive(min_length)
-                            && min_length < g.spacing =>
-                    {
-                        Some(OneGripper {
-                            max_mass,
-                            max_moment,
-                            min_length,
-                        })
-                    }
-                    _ => {
-                        return Err(bad(
-                            "gripper",
-                            "one_gripper_max_mass",
-                            "one_gripper_max_mass (kg), one_gripper_max_moment (N m) and one_gripper_min_length (m) go together: give all three, positive, the length below the spacing (or none: pieces shorter than the spacing are refused)".into(),
-                        ));
-                    }
-                };
-                let gripper = Gripper {
-                    one_gripper,
-                    count: g.count,
-                    spacing: g.spacing,
-                    stroke: g.stroke,
-                    open_width: g.open_width,
-                    closed_width: g.closed_width,
-                    jaw_depth: g.jaw_depth,
-                    max_lumber: g.max_lumber,
-                    max_lumber_section: g.max_lumber_section,
-                };
-                let [t, w] = gripper.max_lumber_section;
-                if !gripper.takes(t, w) {
-                    return Err(bad(
-                        "gripper",
-                        "max_lumber_section",
-                        format!(
-                            "{t} x {w} m does not fit the jaws ({} to {} m)",
-                            gripper.closed_width, gripper.open_width
-                        ),
-                    ));
-                }
-                Some(gripper)
-            }
+            Some(g) => Some(parse_gripper(g, &bad)?),
         };
         let max_nail_lean = match file.nailer {
             None => 0.0,
@@ -397,4 +361,160 @@ impl Tool {
             centre_of_mass: [com.x, com.y, com.z],
         })
     }
+}
+
+/// The `[gripper]` table: jaws on the sides (`holds = "sides"`, the default) or pads on the top
+/// face (`holds = "top"`), each with its own keys.
+fn parse_gripper(
+    g: GripperFile,
+    bad: &dyn Fn(&str, &str, String) -> CellError,
+) -> Result<Gripper, CellError> {
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    let length = |key: &str, v: Option<f64>| match v {
+        Some(v) if positive(v) && v <= 10.0 => Ok(v),
+        Some(v) => Err(bad(
+            "gripper",
+            key,
+            format!("expected a length in m, positive and at most 10 m, got {v}"),
+        )),
+        None => Err(bad(
+            "gripper",
+            key,
+            format!(
+                "`{key}` is missing: a gripper holding the {} needs it",
+                if key == "pad_width" || key == "max_mass" {
+                    "top face (holds = \"top\")"
+                } else {
+                    "sides (holds = \"sides\", the default)"
+                }
+            ),
+        )),
+    };
+    let spacing = length("spacing", Some(g.spacing))?;
+    if !g
+        .max_lumber_section
+        .iter()
+        .all(|v| positive(*v) && *v <= 10.0)
+    {
+        return Err(bad(
+            "gripper",
+            "max_lumber_section",
+            "expected two lengths in m, positive and at most 10 m".into(),
+        ));
+    }
+    let unused =
+        |keys: &[(&str, Option<f64>)], holds: &str| match keys.iter().find(|(_, v)| v.is_some()) {
+            Some((key, _)) => Err(bad(
+                "gripper",
+                key,
+                format!("`{key}` does not apply to a gripper holding the {holds}: remove it"),
+            )),
+            None => Ok(()),
+        };
+    let holds = match g.holds.as_deref().unwrap_or("sides") {
+        "sides" => {
+            unused(
+                &[("pad_width", g.pad_width), ("max_mass", g.max_mass)],
+                "sides",
+            )?;
+            let jaws = Jaws {
+                stroke: length("stroke", g.stroke)?,
+                open_width: length("open_width", g.open_width)?,
+                closed_width: length("closed_width", g.closed_width)?,
+                jaw_depth: length("jaw_depth", g.jaw_depth)?,
+            };
+            if jaws.closed_width >= jaws.open_width {
+                return Err(bad(
+                    "gripper",
+                    "closed_width",
+                    format!(
+                        "closed width {} must be smaller than the open width {}",
+                        jaws.closed_width, jaws.open_width
+                    ),
+                ));
+            }
+            let [t, w] = g.max_lumber_section;
+            if !jaws.takes(t, w) {
+                return Err(bad(
+                    "gripper",
+                    "max_lumber_section",
+                    format!(
+                        "{t} x {w} m does not fit the jaws ({} to {} m)",
+                        jaws.closed_width, jaws.open_width
+                    ),
+                ));
+            }
+            Hold::Sides(jaws)
+        }
+        "top" => {
+            unused(
+                &[
+                    ("stroke", g.stroke),
+                    ("open_width", g.open_width),
+                    ("closed_width", g.closed_width),
+                    ("jaw_depth", g.jaw_depth),
+                ],
+                "top face",
+            )?;
+            let pads = TopPads {
+                pad_width: length("pad_width", g.pad_width)?,
+                max_mass: match g.max_mass {
+                    Some(m) if positive(m) && m <= 1e4 => m,
+                    Some(m) => {
+                        return Err(bad(
+                            "gripper",
+                            "max_mass",
+                            format!("expected a mass in kg, positive and at most 10,000, got {m}"),
+                        ));
+                    }
+                    None => length("max_mass", None)?,
+                },
+            };
+            Hold::Top(pads)
+        }
+        other => {
+            return Err(bad(
+                "gripper",
+                "holds",
+                format!(
+                    "expected \"sides\" (jaws on the piece's side faces) or \"top\" (pads on its top face), got \"{other}\""
+                ),
+            ));
+        }
+    };
+    let one_gripper = match (
+        g.one_gripper_max_mass,
+        g.one_gripper_max_moment,
+        g.one_gripper_min_length,
+    ) {
+        (None, None, None) => None,
+        (Some(max_mass), Some(max_moment), Some(min_length))
+            if [max_mass, max_moment]
+                .iter()
+                .all(|v| positive(*v) && *v <= 1e4)
+                && positive(min_length)
+                && min_length < spacing =>
+        {
+            Some(OneGripper {
+                max_mass,
+                max_moment,
+                min_length,
+            })
+        }
+        _ => {
+            return Err(bad(
+                "gripper",
+                "one_gripper_max_mass",
+                "one_gripper_max_mass (kg), one_gripper_max_moment (N m) and one_gripper_min_length (m) go together: give all three, positive, the length below the spacing (or none: pieces shorter than the spacing are refused)".into(),
+            ));
+        }
+    };
+    Ok(Gripper {
+        count: g.count,
+        spacing,
+        holds,
+        max_lumber: g.max_lumber,
+        max_lumber_section: g.max_lumber_section,
+        one_gripper,
+    })
 }

@@ -24,14 +24,15 @@
 //! | `conveyor1_arrangement` | choice | `end_to_end` (pieces in a line along the belt) or `side_by_side` (across it, fed sideways onto conveyor 2) |
 //! | `conveyor2_x`, `_y`, `_z`, `_yaw`, `_length`, `_width`, `_speed` | value | the same for conveyor 2 |
 //! | `tool_mass` | value | mass of the end effector, kg |
-//! | `gripper_spacing`, `gripper_open_width`, `gripper_closed_width` | value | the tool's grippers (absent for a tool without) |
+//! | `gripper_spacing`, `gripper_open_width`, `gripper_closed_width` | value | the tool's grippers (absent for a tool without; the widths only for jaws) |
 //! | `carry_length` | value | the longest piece the conveyors carry (conveyor 2's length, conveyor 1's width side by side or length end to end) |
 //! | `panel_max_length`, `panel_max_height`, `panel_max_mass`, `panel_min_length`, `panel_cap_lap` | value | `[panels]` of the cell file (m, kg) |
+//! | `gripper_holds` | choice | `sides` (jaws on the piece's side faces) or `top` (pads on its top face); absent for a tool without grippers |
 //! | `panels` | choice | `auto` (walls split into panels by `rules/panels.dl`) or `off` (`--panels off`: every wall one panel) |
 //! | `cell_name`, `robot_name`, `tool_name` | choice | names, for messages |
 
 use super::facts::Facts;
-use crate::cell::{Arrangement, Cell, Conveyor, OffsetX, Orientation};
+use crate::cell::{Arrangement, Cell, Conveyor, Hold, OffsetX, Orientation};
 use crate::logic::{Origin, Value};
 
 /// The facts of a cell (keys above), each tuple from the cell file.
@@ -72,8 +73,10 @@ pub fn cell_facts(cell: &Cell) -> Facts {
     value("tool_mass", cell.tool.mass);
     if let Some(g) = &cell.tool.gripper {
         value("gripper_spacing", g.spacing);
-        value("gripper_open_width", g.open_width);
-        value("gripper_closed_width", g.closed_width);
+        if let Some(j) = g.jaws() {
+            value("gripper_open_width", j.open_width);
+            value("gripper_closed_width", j.closed_width);
+        }
     }
     value("carry_length", cell.carry_length());
     let p = &cell.panels;
@@ -111,6 +114,15 @@ pub fn cell_facts(cell: &Cell) -> Facts {
             Arrangement::SideBySide => "side_by_side",
         },
     );
+    if let Some(g) = &cell.tool.gripper {
+        choice(
+            "gripper_holds",
+            match g.holds {
+                Hold::Sides(_) => "sides",
+                Hold::Top(_) => "top",
+            },
+        );
+    }
     choice("panels", cell.panel_mode.as_str());
     choice("cell_name", &cell.name);
     choice("robot_name", &cell.robot.name);

@@ -295,7 +295,7 @@ fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
             p { "The wall laid on the assembly area; the dashed circle is the grip's reach straight down at the assembly surface." }
             (svg::plan_view(input.cell, w, thickness))
             h3 { "Timeline" }
-            p { (format!("Framing {:.1} s, nailing {:.1} s.", w.record.framing_end, w.record.nailing_end - w.record.framing_end)) }
+            p { (format!("Framing {:.1} s, nailing {:.1} s.", w.record.framing_time(), w.record.nailing_time())) }
             (svg::timeline(w))
             h3 { "Contacts" }
             @if contacts.is_empty() { p { "The robot touched nothing it should not have." } }

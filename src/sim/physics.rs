@@ -419,7 +419,12 @@ impl Physics {
         let tool = world
             .insert_body(RigidBodyBuilder::kinematic_position_based().pose(to_pose(&tool_pose)));
         let mut fingers = Vec::new();
-        let open = cell.tool.gripper.as_ref().map_or(0.1, |g| g.open_width);
+        let open = cell
+            .tool
+            .gripper
+            .as_ref()
+            .and_then(|g| g.jaws())
+            .map_or(0.1, |j| j.open_width);
         for part in &cell.tool.parts {
             let name = format!("tool {}", part.name);
             match (&part.shape.shape, part.name.ends_with("_jaws")) {
@@ -710,7 +715,8 @@ impl Physics {
             .tool
             .gripper
             .as_ref()
-            .map_or(0.1, |g| g.open_width);
+            .and_then(|g| g.jaws())
+            .map_or(0.1, |j| j.open_width);
         let width = closed_on.unwrap_or(open);
         for f in &self.fingers {
             if let Some(c) = self.world.colliders.get_mut(f.collider) {

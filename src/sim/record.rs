@@ -100,6 +100,10 @@ pub enum RefusalKind {
     NoGripper,
     /// Thicker or thinner than the jaws open and close.
     OutsideJawRange,
+    /// Its top face is narrower than the pads of a gripper holding the top face.
+    NarrowerThanPads,
+    /// Heavier than the grippers together are rated to hold.
+    TooHeavyForGripper,
     /// Shorter than the distance between the two grippers (and the tool rates no gripper to
     /// hold a piece alone).
     ShorterThanGripperSpacing,
@@ -150,8 +154,13 @@ pub struct WallRecord {
     /// positive towards its upper end (a vertical piece) or its larger-u end (the rest), as
     /// `plan` orders a member's axis.
     pub grips: Vec<(String, f64)>,
+    /// When the last piece's framing ended (s).
     pub framing_end: f64,
+    /// When the run ended (s).
     pub nailing_end: f64,
+    /// Seconds of nailing done before `framing_end`: nails driven before a later piece
+    /// covered them.
+    pub nailing_while_framing: f64,
     /// Physics steps taken.
     pub steps: u64,
     /// The robot's and the lumber's poses over time, for animations.
@@ -362,6 +371,16 @@ pub fn failure_columns(f: &IkFailure) -> (&'static str, String, f64, f64) {
 }
 
 impl WallRecord {
+    /// Seconds spent framing: the run up to `framing_end` less the nailing done on the way.
+    pub fn framing_time(&self) -> f64 {
+        self.framing_end - self.nailing_while_framing
+    }
+
+    /// Seconds spent nailing, during framing and after it.
+    pub fn nailing_time(&self) -> f64 {
+        self.nailing_end - self.framing_time()
+    }
+
     /// The records as facts of `rules/sim.dl`, each tuple's origin naming the event.
     pub fn facts(&self) -> Facts {
         let mut facts = Facts::default();
@@ -493,7 +512,7 @@ impl WallRecord {
             vec![
                 s(&self.wall),
                 f(0.0),
-                f(self.framing_end),
+                f(self.framing_time()),
                 f(self.nailing_end),
             ],
             event("run"),

@@ -2,7 +2,7 @@
 
 use super::paths::distance;
 use super::{Held, WallRun, failure_score, raise};
-use crate::cell::{Arrangement, IkFailure};
+use crate::cell::{Arrangement, Hold, IkFailure};
 use crate::sim::motion::LinearMove;
 use crate::sim::physics::GRAVITY;
 use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
@@ -358,7 +358,8 @@ impl<'a> WallRun<'a> {
         Ok(())
     }
 
-    /// Whether the gripper can take the piece: jaws across its thickness, both grippers on it.
+    /// Whether the gripper can take the piece: jaws across its thickness or pads on its top
+    /// face, both grippers on it or one rated to hold it alone.
     pub(super) fn grip_check(&self, piece: &ScenePiece) -> Result<(), Refusal> {
         let Some(g) = &self.cell.tool.gripper else {
             return Err(Refusal::new(
@@ -367,16 +368,42 @@ impl<'a> WallRun<'a> {
             ));
         };
         let [length, _, thickness] = piece.size;
-        if thickness > g.open_width || thickness < g.closed_width {
-            return Err(Refusal::new(
-                RefusalKind::OutsideJawRange,
-                format!(
-                    "its thickness {:.0} mm is outside the jaws' range {:.0}..{:.0} mm",
-                    thickness * 1000.0,
-                    g.closed_width * 1000.0,
-                    g.open_width * 1000.0
-                ),
-            ));
+        match &g.holds {
+            Hold::Sides(jaws) => {
+                if thickness > jaws.open_width || thickness < jaws.closed_width {
+                    return Err(Refusal::new(
+                        RefusalKind::OutsideJawRange,
+                        format!(
+                            "its thickness {:.0} mm is outside the jaws' range {:.0}..{:.0} mm",
+                            thickness * 1000.0,
+                            jaws.closed_width * 1000.0,
+                            jaws.open_width * 1000.0
+                        ),
+                    ));
+                }
+            }
+            Hold::Top(pads) => {
+                // On edge its top face is as wide as it is thick; lying flat, wider.
+                if thickness < pads.pad_width {
+                    return Err(Refusal::new(
+                        RefusalKind::NarrowerThanPads,
+                        format!(
+                            "its top face is {:.0} mm wide, narrower than the pads ({:.0} mm)",
+                            thickness * 1000.0,
+                            pads.pad_width * 1000.0
+                        ),
+                    ));
+                }
+                if piece.mass > pads.max_mass {
+                    return Err(Refusal::new(
+                        RefusalKind::TooHeavyForGripper,
+                        format!(
+                            "it weighs {:.1} kg: the pads hold at most {:.1} kg",
+                            piece.mass, pads.max_mass
+                        ),
+                    ));
+                }
+            }
         }
         if length < g.spacing {
             let Some(one) = g.one_gripper else {

@@ -154,14 +154,40 @@ impl<'a> WallRun<'a> {
             .map(|(a, b, _)| (a, b))
             .collect();
         let total = self.pieces.len();
+        let mut driven = vec![false; nails.len()];
         for (done, piece) in self.pieces.clone().into_iter().enumerate() {
             (self.progress)(done, total);
             self.check_time()?;
+            // A piece laid over a nail's entry point (a cap plate on its top plate) would
+            // shut the nailer out: the nails it covers are driven first, as a framing
+            // station nails a plate before the next layer goes on.
+            let covered: Vec<&NailPlan> = nails
+                .iter()
+                .zip(driven.iter_mut())
+                .filter(|(nail, done)| {
+                    !**done && self.both_placed(nail) && self.covers(piece, nail)
+                })
+                .map(|(nail, done)| {
+                    *done = true;
+                    nail
+                })
+                .collect();
+            if !covered.is_empty() {
+                let start = self.t;
+                self.nail_all(&covered);
+                self.record.nailing_while_framing += self.t - start;
+            }
             self.frame(piece);
         }
         self.record.framing_end = self.t;
         self.check_time()?;
-        self.nail_all(nails);
+        let rest: Vec<&NailPlan> = nails
+            .iter()
+            .zip(&driven)
+            .filter(|(_, done)| !**done)
+            .map(|(nail, _)| nail)
+            .collect();
+        self.nail_all(&rest);
         self.record.nailing_end = self.t;
         self.check_time()?;
         self.settle();

@@ -9,6 +9,7 @@ use crate::frame::plan::NailingTarget;
 use crate::sim::motion::LinearMove;
 use crate::sim::reach::{continuous_line_where, touches};
 use crate::sim::record::{NailOutcome, NailRecord, RobotStep, StepFor, failure_columns};
+use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
 /// The nailer approaches along the nail line from this far back (m).
@@ -21,6 +22,11 @@ pub(super) const NAIL_DESCENT: f64 = 0.10;
 pub(super) const NAIL_STANDOFF: f64 = 0.01;
 /// Where the nailer fires: its nose this far off the plate's face (m).
 pub(super) const NOSE_GAP: f64 = 0.002;
+
+/// A piece this close to the line back out of a nail's entry point covers the nail (m)...
+const COVER_CLEARANCE: f64 = 0.01;
+/// ...along this much of the line: the nailer's nose and its straight approach (m).
+const COVER_DEPTH: f64 = NAIL_APPROACH + 0.05;
 
 /// How many approach poses of one nail the executor tries to move to before giving up.
 const MAX_PATH_TRIES: usize = 3;
@@ -82,9 +88,10 @@ impl NailPlan {
 }
 
 impl<'a> WallRun<'a> {
-    pub(super) fn nail_all(&mut self, nails: &[NailPlan]) {
+    /// Drives `nails` in their order; a nail whose plate or member was not placed is skipped.
+    pub(super) fn nail_all(&mut self, nails: &[&NailPlan]) {
         let nail_tcp = *self.cell.tool.tcp("nail").expect("cells have a nail TCP");
-        for nail in nails {
+        for &nail in nails {
             self.record.program.push(RobotStep::Begin(StepFor::Nail {
                 plate: nail.plate.clone(),
                 member: nail.member.clone(),
@@ -289,6 +296,25 @@ impl<'a> WallRun<'a> {
         continuous_line_where(at, &self.q, (back, fire), tcp, 4, collides).map(|(q_back, _)| q_back)
     }
 
+    /// Whether the nail's plate and member are both in place.
+    pub(super) fn both_placed(&self, nail: &NailPlan) -> bool {
+        self.placed.contains_key(&nail.plate) && self.placed.contains_key(&nail.member)
+    }
+
+    /// Whether `piece`, once at its framing target, lies over `nail`'s entry point: within
+    /// `COVER_CLEARANCE` of the line back out of the face along which the nailer drives it.
+    pub(super) fn covers(&self, piece: &ScenePiece, nail: &NailPlan) -> bool {
+        let entry = self.wall_cell * Point3::from(Vector3::from(nail.uvw));
+        let out = -(self.wall_cell.rotation * nail.direction);
+        let to_piece = piece.target_cell.inverse();
+        let half = piece.size.map(|s| s / 2.0 + COVER_CLEARANCE);
+        segment_meets_box(
+            &(to_piece * entry),
+            &(to_piece.rotation * out * COVER_DEPTH),
+            &half,
+        )
+    }
+
     /// Whether a nail entering at `point` along `line` (cell frame) runs through its plate into
     /// its member where both were placed.
     fn runs_into_as_planned(
@@ -345,4 +371,59 @@ fn nail_approaches(pose: Isometry3<f64>) -> impl Iterator<Item = Isometry3<f64>>
         )
     });
     std::iter::once(along).chain(from_above)
+}
+
+/// Whether the segment from `start` along `run` meets the axis-aligned box of half sizes
+/// `half` about the origin (the slab test: the segment's parameter interval inside every slab).
+fn segment_meets_box(start: &Point3<f64>, run: &Vector3<f64>, half: &[f64; 3]) -> bool {
+    let (mut enter, mut leave) = (0.0f64, 1.0f64);
+    for axis in 0..3 {
+        let (p, d, h) = (start[axis], run[axis], half[axis]);
+        if d.abs() < 1e-12 {
+            if p.abs() > h {
+                return false;
+            }
+            continue;
+        }
+        let (a, b) = ((-h - p) / d, (h - p) / d);
+        enter = enter.max(a.min(b));
+        leave = leave.min(a.max(b));
+        if enter > leave {
+            return false;
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_segment_meets_a_box_it_passes_through_and_misses_one_beside_it() {
+        let half = [1.0, 0.5, 0.25];
+        let up = Vector3::new(0.0, 0.0, 1.0);
+        // From below the box straight up through it.
+        assert!(segment_meets_box(&Point3::new(0.5, 0.0, -1.0), &up, &half));
+        // Ends short of its underside.
+        assert!(!segment_meets_box(
+            &Point3::new(0.5, 0.0, -1.0),
+            &(up * 0.7),
+            &half
+        ));
+        // Runs beside it.
+        assert!(!segment_meets_box(
+            &Point3::new(1.1, 0.0, -1.0),
+            &(up * 3.0),
+            &half
+        ));
+        // Starts on its face, going away: touches at the start.
+        assert!(segment_meets_box(&Point3::new(0.0, 0.0, 0.25), &up, &half));
+        // Diagonal through a corner region it misses.
+        assert!(!segment_meets_box(
+            &Point3::new(2.0, 0.0, 0.0),
+            &Vector3::new(-0.9, 0.0, 0.9),
+            &half
+        ));
+    }
 }
