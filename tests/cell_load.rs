@@ -326,3 +326,53 @@ fn a_gripper_holding_the_top_face_has_pads_and_no_jaws() {
         .to_string();
     assert!(msg.contains("stroke") && msg.contains("sides"), "{msg}");
 }
+
+/// A slow end section of conveyor 2 needs both its speed (below the belt's) and its length
+/// (within the belt); the line has one.
+#[test]
+fn a_creep_section_needs_its_speed_and_length_within_the_belt() {
+    let line = Cell::load("framing-line").unwrap();
+    let creep = line
+        .conveyor2
+        .creep
+        .expect("the line's pick belt has a slow end");
+    assert!(creep.speed < line.conveyor2.speed && creep.length <= line.conveyor2.length);
+    assert!(Cell::load("study-abb").unwrap().conveyor2.creep.is_none());
+    let text = include_str!("../robots/cells/framing-line.toml");
+    for (from, to) in [
+        ("creep_length = 0.6\n", ""),
+        ("creep_speed = 0.3", "creep_speed = 2.5"),
+        ("creep_length = 0.6", "creep_length = 13.0"),
+        ("creep_speed = 0.3", "creep_speed = -0.3"),
+    ] {
+        let bad = text.replace(from, to);
+        assert_ne!(bad, text, "{from}");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("creep.toml");
+        std::fs::write(&path, bad).unwrap();
+        let msg = Cell::load(path.to_str().unwrap()).unwrap_err().to_string();
+        assert!(
+            msg.contains("creep.toml:") && msg.contains("conveyor2.creep_speed"),
+            "{to}: {msg}"
+        );
+    }
+}
+
+/// The line's nailer rides back on a slide while the tool frames; the study's is fixed.
+#[test]
+fn a_nailer_slide_is_within_half_a_metre() {
+    assert!(Tool::study().nailer_slide == 0.0);
+    let line = include_str!("../robots/tools/line-vacuum-nailer.toml");
+    assert!(Tool::load("line-vacuum-nailer").unwrap().nailer_slide > 0.0);
+    for bad in ["-0.1", "0.6", "nan"] {
+        let text = line.replace("slide = 0.10", &format!("slide = {bad}"));
+        assert_ne!(text, line);
+        let msg = Tool::parse(Path::new("slide.toml"), &text)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("slide.toml:") && msg.contains("nailer.slide"),
+            "{bad}: {msg}"
+        );
+    }
+}

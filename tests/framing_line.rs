@@ -2,6 +2,8 @@
 //! gantry over the framing table. Its kinematics are checked against the floor-mounted robot's
 //! own chain turned over by hand; its runs against the models' ground truth.
 
+mod common;
+
 use framewright::cell::Cell;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use serde_json::Value;
@@ -15,9 +17,14 @@ fn example(name: &str) -> PathBuf {
 }
 
 fn simulate_json(model: &Path, cell: &str) -> Value {
+    simulate_json_with(model, cell, &[])
+}
+
+fn simulate_json_with(model: &Path, cell: &str, args: &[&str]) -> Value {
     let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
         .args(["simulate", model.to_str().unwrap(), "--cell", cell])
         .args(["--json", "--no-cache"])
+        .args(args)
         .output()
         .expect("framewright runs");
     assert!(
@@ -136,4 +143,176 @@ fn a_cell_with_an_unknown_mounting_is_refused_with_its_key() {
         "{err}"
     );
     assert!(err.contains("bad.toml"), "{err}");
+}
+
+/// The world (`framewright world --format json`) of a model on a cell.
+fn world_json(model: &Path, cell: &str) -> Value {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("world.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(["world", model.to_str().unwrap(), "--cell", cell])
+        .args(["--format", "json", "--output", path.to_str().unwrap()])
+        .output()
+        .expect("framewright runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
+}
+
+/// Column `axis` of a pose's 4x4 matrix: where the piece's length (0), width (1) or thickness
+/// (2) axis points.
+fn axis(pose: &Value, axis: usize) -> Vector3<f64> {
+    let m = &pose["matrix"];
+    Vector3::from_fn(|row, _| m[row][axis].as_f64().unwrap())
+}
+
+/// A gripper holding the top face cannot turn a piece over between pick and place: a piece
+/// that lies flat on the table at its target (a header on edge in the wall, whose width runs
+/// up the wall and so lies level when the wall is laid down) is fed flat to it, thickness up;
+/// the study's jaws take every piece on edge, width up.
+#[test]
+fn a_piece_flat_at_its_target_is_fed_flat_to_grippers_holding_the_top_face() {
+    let model =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/synth_wall_door_window_in.ifc");
+    let truth: Value =
+        serde_json::from_str(&std::fs::read_to_string(model.with_extension("truth.json")).unwrap())
+            .unwrap();
+    let line = world_json(&model, "framing-line");
+    let study = world_json(&model, "study-abb");
+    // Lumber spawns on conveyor 1.
+    let belt_top = Cell::load("framing-line")
+        .unwrap()
+        .conveyor1
+        .pose
+        .translation
+        .z;
+    let mut flat = vec![];
+    for (p, q) in line["pieces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(study["pieces"].as_array().unwrap())
+    {
+        assert_eq!(p["id"], q["id"]);
+        // Flat at its target: its width axis lies (nearly) level on the table.
+        let lies_flat = axis(&p["framing_target"]["cell"], 1).z.abs() < 0.9;
+        let up = if lies_flat { 2 } else { 1 };
+        assert!(
+            axis(&p["spawn"], up).z.abs() > 0.999,
+            "{}: fed with axis {up} up on the line",
+            p["id"]
+        );
+        assert!(
+            axis(&q["spawn"], 1).z.abs() > 0.999,
+            "{}: on edge for the jaws",
+            q["id"]
+        );
+        if lies_flat {
+            flat.push(p["id"].as_str().unwrap().to_string());
+            // Lying on the belt: its centre half its thickness above the belt top.
+            let t = p["size"][2].as_f64().unwrap();
+            let z = p["spawn"]["position"][2].as_f64().unwrap();
+            assert!(
+                (z - (belt_top + t / 2.0)).abs() < 1e-6,
+                "{}: z {z}",
+                p["id"]
+            );
+        }
+    }
+    // The model's headers are two plies of 2x10 on edge in the wall, 1/2 inch apart (the
+    // spacer between them is not modelled).
+    let headers: Vec<&Value> = truth["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["role"] == "header")
+        .collect();
+    let mut ids: Vec<String> = headers
+        .iter()
+        .map(|h| h["global_id"].as_str().unwrap().to_string())
+        .collect();
+    ids.sort();
+    flat.sort();
+    assert_eq!(flat, ids, "the headers lie flat on the table");
+
+    // The line frames every member but the inner plies: laid on the table, an inner ply's
+    // target lies the missing spacer's thickness above the outer ply, and released there it
+    // drops onto it by exactly that much.
+    let sim = simulate_json(&model, "framing-line");
+    let elements = sim["elements"].as_array().unwrap();
+    assert_eq!(
+        elements.len() as u64,
+        truth["counts"]["members"].as_u64().unwrap()
+    );
+    for e in elements {
+        let inner = headers.iter().find(|h| {
+            h["global_id"] == e["id"] && h["role_detail"].as_str().unwrap().contains("inner")
+        });
+        let Some(inner) = inner else {
+            assert_eq!(e["framing"]["status"], "framed", "{e}");
+            continue;
+        };
+        let outer = headers
+            .iter()
+            .find(|h| {
+                h["axis_start"][0] == inner["axis_start"][0] && h["global_id"] != inner["global_id"]
+            })
+            .unwrap();
+        let gap = (inner["axis_start"][1].as_f64().unwrap()
+            - outer["axis_start"][1].as_f64().unwrap())
+        .abs()
+            - inner["thickness"].as_f64().unwrap();
+        let reason = e["framing"]["reasons"][0]["message"].as_str().unwrap();
+        let mm: f64 = reason
+            .strip_prefix("came to rest ")
+            .and_then(|r| r.split(' ').next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("{reason}"));
+        assert!(
+            (mm - gap * 1000.0).abs() < 0.5,
+            "{reason}: the gap is {gap} m"
+        );
+    }
+}
+
+/// The line's pick belt ends in a slow section: a 60 mm block pushed onto it beside the sensor
+/// meets the end stop at the creep speed and stays on edge. Without the slow section the same
+/// blocks tip over against the stop.
+#[test]
+fn short_blocks_meet_the_end_stop_slowly_and_stay_on_edge() {
+    let Some(model) = common::shared_path("ifc-testcases/g_scale_3storey.ifc") else {
+        return;
+    };
+    // A wall of the 3-storey model with three 60 mm cripples (under its window sills).
+    let wall = "0ZxqTpovzA$h0MfOGE1WTG";
+    let sim = simulate_json_with(&model, "framing-line", &["--wall", wall]);
+    let elements = sim["elements"].as_array().unwrap();
+    assert!(!elements.is_empty());
+    for e in elements {
+        assert_eq!(e["framing"]["status"], "framed", "{e}");
+    }
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/cells/framing-line.toml"),
+    )
+    .unwrap();
+    let without: String = text
+        .lines()
+        .filter(|l| !l.starts_with("creep_"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_ne!(without, text, "the line's cell file has a slow section");
+    let dir = tempfile::tempdir().unwrap();
+    let cell = dir.path().join("no-creep.toml");
+    std::fs::write(&cell, without).unwrap();
+    let sim = simulate_json_with(&model, cell.to_str().unwrap(), &["--wall", wall]);
+    let toppled: Vec<&Value> = sim["elements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["framing"]["reasons"].to_string().contains("toppled"))
+        .collect();
+    assert_eq!(toppled.len(), 3, "{toppled:?}");
 }

@@ -854,3 +854,44 @@ fn a_signal_of_the_other_language_is_refused_and_nothing_is_written() {
     );
     assert!(!out.exists(), "nothing written");
 }
+
+/// The line's nailer rides back on a slide while the tool frames: its program runs the slide
+/// out before nailing and back after, and fires only with the slide out. The study's tool has
+/// no slide and its programs drive no slide signal.
+#[test]
+fn the_nailer_fires_only_with_its_slide_out() {
+    for (cell, slide) in [("framing-line", true), ("study-abb", false)] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        run(&[
+            "program",
+            example("tm3.ifc").to_str().unwrap(),
+            "--cell",
+            cell,
+            "--format",
+            "rapid",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let mut fired = 0;
+        for entry in std::fs::read_dir(&out).unwrap() {
+            let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+            let mut slide_out = false;
+            let mut moved = false;
+            for line in text.lines().map(str::trim) {
+                match line {
+                    "SetDO doNailerSlide, 1;" => (slide_out, moved) = (true, true),
+                    "SetDO doNailerSlide, 0;" => (slide_out, moved) = (false, true),
+                    "SetDO doNailerFire, 1;" => {
+                        fired += 1;
+                        assert_eq!(slide_out, slide, "{cell}: fired with the slide out");
+                    }
+                    _ => {}
+                }
+            }
+            assert_eq!(moved, slide, "{cell}: the slide signal");
+            assert!(!slide_out, "{cell}: the program ends with the slide back");
+        }
+        assert!(fired > 0, "{cell}: nails fired");
+    }
+}

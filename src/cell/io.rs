@@ -23,6 +23,8 @@ pub struct Io {
     pub gripper_open: Option<Signal>,
     /// Output that fires the nailer.
     pub nailer_fire: Option<Signal>,
+    /// Output that runs the nailer out on its slide (a tool with `[nailer] slide`).
+    pub nailer_slide: Option<Signal>,
     /// Input the touch sensor sets while a piece rests against it.
     pub part_present: Option<Signal>,
 }
@@ -34,11 +36,12 @@ pub const KRL_SIGNAL_MAX: i64 = 4096;
 
 impl Io {
     /// The keys with their signals, in file order.
-    pub fn signals(&self) -> [(&'static str, Option<&Signal>); 4] {
+    pub fn signals(&self) -> [(&'static str, Option<&Signal>); 5] {
         [
             ("gripper_close", self.gripper_close.as_ref()),
             ("gripper_open", self.gripper_open.as_ref()),
             ("nailer_fire", self.nailer_fire.as_ref()),
+            ("nailer_slide", self.nailer_slide.as_ref()),
             ("part_present", self.part_present.as_ref()),
         ]
     }

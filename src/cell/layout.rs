@@ -263,6 +263,9 @@ struct Conveyor2Section {
     width: f64,
     #[serde(default = "speed_2")]
     speed: f64,
+    /// A slow end section: the belt's last `creep_length` runs at `creep_speed`.
+    creep_speed: Option<f64>,
+    creep_length: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -332,6 +335,18 @@ pub struct Conveyor {
     pub width: f64,
     /// Belt speed, m/s.
     pub speed: f64,
+    /// A slow end section before the end stop, where the belt has one.
+    pub creep: Option<Creep>,
+}
+
+/// The last `length` of a belt before its downstream end runs at `speed`: lumber meets the end
+/// stop slowly (a short block arriving at full speed tips over against it).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Creep {
+    /// m/s
+    pub speed: f64,
+    /// m
+    pub length: f64,
 }
 
 impl Conveyor {
@@ -626,6 +641,29 @@ impl Cell {
         size("conveyor2", "length", &[c2.length], 100.0)?;
         size("conveyor2", "width", &[c2.width], 10.0)?;
         speed("conveyor2", c2.speed)?;
+        let creep = match (c2.creep_speed, c2.creep_length) {
+            (None, None) => None,
+            (Some(speed), Some(length))
+                if speed.is_finite()
+                    && speed > 0.0
+                    && speed < c2.speed
+                    && length.is_finite()
+                    && length > 0.0
+                    && length <= c2.length =>
+            {
+                Some(Creep { speed, length })
+            }
+            _ => {
+                return Err(bad(
+                    "conveyor2",
+                    "creep_speed",
+                    format!(
+                        "creep_speed (m/s, above 0 and below the belt's speed {}) and creep_length (m, above 0 and at most the belt's length {}) go together: give both, or neither for a belt at one speed",
+                        c2.speed, c2.length
+                    ),
+                ));
+            }
+        };
         let s = &f.touch_sensor;
         size("touch_sensor", "size", &s.size, 5.0)?;
         if !(s.pick_offset.is_finite() && s.pick_offset >= 0.0 && s.pick_offset <= c2.length) {
@@ -711,12 +749,14 @@ impl Cell {
             length: c1.length,
             width: c1.width,
             speed: c1.speed,
+            creep: None,
         };
         let conveyor2 = Conveyor {
             pose: belt(c2.position, c2.direction_deg),
             length: c2.length,
             width: c2.width,
             speed: c2.speed,
+            creep,
         };
         let face = conveyor2.downstream_end();
         let dir = conveyor2.direction();

@@ -13,6 +13,8 @@ use std::path::Path;
 
 /// The steepest lean a tool file may allow: toe nails are driven at about 30° to the member.
 const MAX_LEAN_DEG: f64 = 30.0;
+/// The longest nailer slide a tool file may give (m).
+const MAX_SLIDE: f64 = 0.5;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -29,6 +31,8 @@ struct ToolFile {
 #[serde(deny_unknown_fields)]
 struct NailerFile {
     max_lean_deg: f64,
+    #[serde(default)]
+    slide: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -184,6 +188,9 @@ pub struct Tool {
     /// How far (rad) a nail may lean off the planned line, tipped up or down in the vertical
     /// plane through it, where the square nail is out of reach; 0 drives every nail square.
     pub max_nail_lean: f64,
+    /// How far the nailer (the parts named `nailer…`) rides back on a slide towards the
+    /// flange while it is not nailing, m; 0: fixed where the file places it (out).
+    pub nailer_slide: f64,
     /// Total mass, kg.
     pub mass: f64,
     /// Centre of mass in tool0, m (part shapes' centres weighted by part masses).
@@ -324,6 +331,19 @@ impl Tool {
             None => None,
             Some(g) => Some(parse_gripper(g, &bad)?),
         };
+        let nailer_slide = match file.nailer.as_ref().and_then(|n| n.slide) {
+            None => 0.0,
+            Some(s) if s.is_finite() && (0.0..=MAX_SLIDE).contains(&s) => s,
+            Some(s) => {
+                return Err(bad(
+                    "nailer",
+                    "slide",
+                    format!(
+                        "expected how far the nailer rides back, in m from 0 to {MAX_SLIDE}, got {s}"
+                    ),
+                ));
+            }
+        };
         let max_nail_lean = match file.nailer {
             None => 0.0,
             Some(n)
@@ -357,6 +377,7 @@ impl Tool {
             tcps,
             gripper,
             max_nail_lean,
+            nailer_slide,
             mass,
             centre_of_mass: [com.x, com.y, com.z],
         })

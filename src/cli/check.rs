@@ -39,7 +39,7 @@ pub struct CheckArgs {
 /// The options every command that reasons a model shares (plan, check, why).
 #[derive(clap::Args)]
 pub struct ReasoningInputs {
-    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    /// The robot cell: a built-in name (study-abb, study-kuka, study-abb-track, framing-line) or a TOML file.
     #[arg(long, default_value = "study-abb")]
     pub cell: String,
     /// Replace the built-in rule base with every .dl file of this directory.

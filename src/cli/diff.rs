@@ -19,7 +19,7 @@ pub struct DiffArgs {
     pub old: PathBuf,
     /// The model after the edit.
     pub new: PathBuf,
-    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    /// The robot cell: a built-in name (study-abb, study-kuka, study-abb-track, framing-line) or a TOML file.
     #[arg(long, default_value = "study-abb")]
     pub cell: String,
     /// Print JSON instead of one line per change.

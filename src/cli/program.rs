@@ -15,7 +15,7 @@ use std::path::PathBuf;
 pub struct ProgramArgs {
     /// The IFC model.
     pub model: PathBuf,
-    /// The robot cell: a built-in name (study-abb, study-kuka, study-abb-track) or a TOML file.
+    /// The robot cell: a built-in name (study-abb, study-kuka, study-abb-track, framing-line) or a TOML file.
     #[arg(long, default_value = "study-abb")]
     pub cell: String,
     /// The controller language: `rapid` (ABB, one .mod per wall) or `krl` (KUKA, a .src and

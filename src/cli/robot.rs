@@ -62,7 +62,7 @@ pub enum RobotCommand {
     },
     /// Load and check a cell file (or built-in cell) and print its layout summary.
     Cell {
-        /// Built-in cell (study-abb, study-kuka) or a cell TOML path.
+        /// Built-in cell (study-abb, study-kuka, study-abb-track, framing-line) or a cell TOML path.
         cell: String,
         #[arg(long)]
         json: bool,

@@ -22,7 +22,7 @@ use std::sync::Mutex;
 pub struct SimulateArgs {
     /// The IFC model.
     pub model: PathBuf,
-    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    /// The robot cell: a built-in name (study-abb, study-kuka, study-abb-track, framing-line) or a TOML file.
     #[arg(long, default_value = "study-abb")]
     pub cell: String,
     /// Print JSON instead of the tables.

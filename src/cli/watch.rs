@@ -32,7 +32,7 @@ use std::time::Duration;
 pub struct WatchArgs {
     /// The IFC model to watch.
     pub model: PathBuf,
-    /// The robot cell: a built-in name (study-abb, study-kuka) or a TOML file.
+    /// The robot cell: a built-in name (study-abb, study-kuka, study-abb-track, framing-line) or a TOML file.
     #[arg(long, default_value = "study-abb")]
     pub cell: String,
     /// Your rule file (as for simulate); repeat for more.

@@ -26,7 +26,7 @@ pub enum WorldFormat {
 pub struct WorldArgs {
     /// The IFC model.
     pub model: PathBuf,
-    /// Built-in cell name (study-abb, study-kuka) or a cell TOML file.
+    /// Built-in cell name (study-abb, study-kuka, study-abb-track, framing-line) or a cell TOML file.
     #[arg(long, default_value = "study-abb")]
     pub cell: String,
     #[arg(long, value_enum)]

@@ -19,6 +19,7 @@ pub fn default_signal(role: SignalRole) -> i64 {
         SignalRole::GripperClose => 1,
         SignalRole::GripperOpen => 2,
         SignalRole::NailerFire => 3,
+        SignalRole::NailerSlide => 4,
         SignalRole::PartPresent => 1,
     }
 }

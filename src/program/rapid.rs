@@ -20,6 +20,7 @@ pub fn default_signal(role: SignalRole) -> &'static str {
         SignalRole::GripperClose => "doGripperClose",
         SignalRole::GripperOpen => "doGripperOpen",
         SignalRole::NailerFire => "doNailerFire",
+        SignalRole::NailerSlide => "doNailerSlide",
         SignalRole::PartPresent => "diPartPresent",
     }
 }

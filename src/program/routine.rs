@@ -30,6 +30,7 @@ pub enum SignalRole {
     GripperClose,
     GripperOpen,
     NailerFire,
+    NailerSlide,
     PartPresent,
 }
 
@@ -40,6 +41,7 @@ impl SignalRole {
             SignalRole::GripperClose => "gripper_close",
             SignalRole::GripperOpen => "gripper_open",
             SignalRole::NailerFire => "nailer_fire",
+            SignalRole::NailerSlide => "nailer_slide",
             SignalRole::PartPresent => "part_present",
         }
     }
@@ -211,8 +213,8 @@ pub fn routine(input: &RoutineInput) -> Routine {
                 });
                 let target = out.joints.len() - 1;
                 // The run's first step puts the arm at its home pose: a joint move there
-                // from wherever the arm stands, in the controller's own time; the jaws open
-                // and the nailer off, whatever an aborted run left them.
+                // from wherever the arm stands, in the controller's own time; the jaws open,
+                // the nailer off and back on its slide, whatever an aborted run left them.
                 if start {
                     out.body.push(Instr::Joint {
                         target,
@@ -222,6 +224,9 @@ pub fn routine(input: &RoutineInput) -> Routine {
                         fine: true,
                     });
                     out.body.push(set(SignalRole::NailerFire, false));
+                    if input.cell.tool.nailer_slide > 0.0 {
+                        out.body.push(set(SignalRole::NailerSlide, false));
+                    }
                     out.body.push(set(SignalRole::GripperClose, false));
                     out.body.push(set(SignalRole::GripperOpen, true));
                 } else {
@@ -238,6 +243,15 @@ pub fn routine(input: &RoutineInput) -> Routine {
             RobotStep::Release if kept => {
                 out.body.push(set(SignalRole::GripperClose, false));
                 out.body.push(set(SignalRole::GripperOpen, true));
+            }
+            // The slide moves whether or not the nail it serves was driven: the arm's next
+            // moves assume where it stands.
+            RobotStep::NailerSlide {
+                out: extend,
+                seconds,
+            } => {
+                out.body.push(set(SignalRole::NailerSlide, *extend));
+                out.body.push(Instr::Wait(*seconds));
             }
             RobotStep::Fire if kept => {
                 out.body.push(set(SignalRole::NailerFire, true));

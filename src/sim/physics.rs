@@ -57,9 +57,29 @@ pub const FINGER: f64 = 0.010;
 /// The belts: fixed colliders whose contacts get a tangential velocity (rapier's way of
 /// modelling a moving belt surface).
 pub struct Belts {
-    belts: Vec<(ColliderHandle, Vector, f32)>,
+    belts: Vec<Belt>,
     /// Both belts stop while the sensor holds a piece.
     pub running: bool,
+}
+
+/// One belt's slab, travel direction and speed; its slow end section, where it has one: (the
+/// downstream end's distance along the travel direction from the origin, the section's length
+/// and speed).
+struct Belt {
+    collider: ColliderHandle,
+    direction: Vector,
+    speed: f32,
+    creep: Option<(f32, f32, f32)>,
+}
+
+impl Belt {
+    /// The belt surface's speed under a contact point (world frame).
+    fn speed_at(&self, point: Vector) -> f32 {
+        match self.creep {
+            Some((end, length, creep)) if end - point.dot(self.direction) <= length => creep,
+            _ => self.speed,
+        }
+    }
 }
 
 impl PhysicsHooks for Belts {
@@ -67,19 +87,19 @@ impl PhysicsHooks for Belts {
         if !self.running {
             return;
         }
-        for (belt, direction, speed) in &self.belts {
+        for belt in &self.belts {
             // tangent_velocity is the surface velocity of collider 1 relative to collider 2.
-            let sign = if ctx.collider1 == *belt {
+            let sign = if ctx.collider1 == belt.collider {
                 1.0
-            } else if ctx.collider2 == *belt {
+            } else if ctx.collider2 == belt.collider {
                 -1.0
             } else {
                 continue;
             };
-            let v = *direction * (*speed * sign);
             if let Some(contacts) = ctx.rigid_mut() {
+                // Inside this hook a contact's anchor1 is its world point.
                 for c in contacts.solver_contacts.iter_mut() {
-                    c.tangent_velocity = v;
+                    c.tangent_velocity = belt.direction * (belt.speed_at(c.anchor1) * sign);
                 }
             }
             return;
@@ -111,6 +131,11 @@ pub struct Physics {
     pub links: Vec<(usize, RigidBodyHandle)>,
     pub tool: RigidBodyHandle,
     fingers: Vec<Finger>,
+    /// The nailer's parts on their slide (a tool with `[nailer] slide`): each collider and its
+    /// pose in tool0 when the nailer is out (as the tool file places it).
+    nailer: Vec<(ColliderHandle, Isometry3<f64>)>,
+    /// How far the slide takes the nailer back towards the flange (m), and whether it is out.
+    nailer_slide: (f64, bool),
     /// Every collider of the robot and its tool.
     pub robot_colliders: Vec<ColliderHandle>,
     /// The robot's colliders that move (not the base link's) and the body each belongs to.
@@ -285,11 +310,20 @@ impl Physics {
                 .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS),
             );
             let direction = c.direction().cast::<f32>();
-            belts.push((
-                belt,
-                Vector::new(direction.x, direction.y, direction.z),
-                c.speed as f32,
-            ));
+            let direction = Vector::new(direction.x, direction.y, direction.z);
+            let end = c.downstream_end().coords.cast::<f32>();
+            belts.push(Belt {
+                collider: belt,
+                direction,
+                speed: c.speed as f32,
+                creep: c.creep.map(|k| {
+                    (
+                        Vector::new(end.x, end.y, end.z).dot(direction),
+                        k.length as f32,
+                        k.speed as f32,
+                    )
+                }),
+            });
             let frame_height = c.pose.translation.z - BELT_SLAB - f.z;
             if frame_height > 0.01 {
                 let frame =
@@ -419,6 +453,7 @@ impl Physics {
         let tool = world
             .insert_body(RigidBodyBuilder::kinematic_position_based().pose(to_pose(&tool_pose)));
         let mut fingers = Vec::new();
+        let mut nailer = Vec::new();
         let open = cell
             .tool
             .gripper
@@ -459,6 +494,12 @@ impl Physics {
                     );
                     names.insert(c, name);
                     robot_colliders.push(c);
+                    if cell.tool.nailer_slide > 0.0 && part.name.starts_with("nailer") {
+                        // The run starts with the nailer back on its slide.
+                        let back = retracted(&part.shape.origin, cell.tool.nailer_slide);
+                        world.colliders[c].set_position_wrt_parent(to_pose(&back));
+                        nailer.push((c, part.shape.origin));
+                    }
                 }
             }
         }
@@ -485,6 +526,8 @@ impl Physics {
             links,
             tool,
             fingers,
+            nailer,
+            nailer_slide: (cell.tool.nailer_slide, false),
             robot_colliders,
             moving_shapes,
             sensor,
@@ -721,6 +764,26 @@ impl Physics {
         for f in &self.fingers {
             if let Some(c) = self.world.colliders.get_mut(f.collider) {
                 c.set_position_wrt_parent(to_pose(&f.offset(width)));
+            }
+        }
+    }
+
+    /// Runs the nailer out on its slide (`true`: where the tool file places it) or back.
+    pub fn set_nailer(&mut self, out: bool) {
+        if self.nailer.is_empty() || self.nailer_slide.1 == out {
+            return;
+        }
+        self.changed(true);
+        self.nailer_slide.1 = out;
+        let slide = self.nailer_slide.0;
+        for (c, origin) in &self.nailer {
+            let pose = if out {
+                *origin
+            } else {
+                retracted(origin, slide)
+            };
+            if let Some(c) = self.world.colliders.get_mut(*c) {
+                c.set_position_wrt_parent(to_pose(&pose));
             }
         }
     }
@@ -1288,6 +1351,11 @@ pub fn collider(shape: &PlacedShape) -> ColliderBuilder {
         Shape::Sphere { radius } => (ColliderBuilder::ball(radius as f32), shape.origin),
     };
     builder.position(to_pose(&pose))
+}
+
+/// A nailer part's pose in tool0 with the nailer `slide` back towards the flange (tool0 -z).
+fn retracted(origin: &Isometry3<f64>, slide: f64) -> Isometry3<f64> {
+    Isometry3::translation(0.0, 0.0, -slide) * origin
 }
 
 #[cfg(test)]

@@ -201,6 +201,8 @@ pub enum RobotStep {
     Release,
     /// The nailer fires.
     Fire,
+    /// The nailer runs out on its slide (`out`) or back, taking `seconds`.
+    NailerSlide { out: bool, seconds: f64 },
     /// The robot waits for the touch sensor to report a piece.
     AwaitPart,
     /// The robot waits this long (s).

@@ -91,6 +91,7 @@ impl<'a> WallRun<'a> {
     /// Drives `nails` in their order; a nail whose plate or member was not placed is skipped.
     pub(super) fn nail_all(&mut self, nails: &[&NailPlan]) {
         let nail_tcp = *self.cell.tool.tcp("nail").expect("cells have a nail TCP");
+        self.slide_nailer(nails.first(), true);
         for &nail in nails {
             self.record.program.push(RobotStep::Begin(StepFor::Nail {
                 plate: nail.plate.clone(),
@@ -188,6 +189,21 @@ impl<'a> WallRun<'a> {
                 );
             }
         }
+        self.slide_nailer(nails.last(), false);
+    }
+
+    /// Runs the nailer out on its slide before the first of a run of nails (`nail`) and back
+    /// after the last, where the tool has a slide; the slide moves in the gripper's time.
+    fn slide_nailer(&mut self, nail: Option<&&NailPlan>, out: bool) {
+        if self.cell.tool.nailer_slide <= 0.0 || nail.is_none() {
+            return;
+        }
+        let seconds = self.cell.motion.grip_dwell;
+        self.phys.set_nailer(out);
+        self.record
+            .program
+            .push(RobotStep::NailerSlide { out, seconds });
+        self.wait(seconds);
     }
 
     /// Chooses how to drive `nail` (square first, then leaning; every roll and approach) and
