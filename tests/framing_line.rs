@@ -21,9 +21,15 @@ fn simulate_json(model: &Path, cell: &str) -> Value {
 }
 
 fn simulate_json_with(model: &Path, cell: &str, args: &[&str]) -> Value {
+    let mut all = vec!["simulate", model.to_str().unwrap(), "--cell", cell];
+    all.extend(["--json", "--no-cache"]);
+    all.extend(args);
+    serde_json::from_slice(&framewright(&all)).expect("JSON")
+}
+
+/// `framewright ARGS…`, which must succeed: its standard output.
+fn framewright(args: &[&str]) -> Vec<u8> {
     let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
-        .args(["simulate", model.to_str().unwrap(), "--cell", cell])
-        .args(["--json", "--no-cache"])
         .args(args)
         .output()
         .expect("framewright runs");
@@ -32,7 +38,7 @@ fn simulate_json_with(model: &Path, cell: &str, args: &[&str]) -> Value {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    serde_json::from_slice(&out.stdout).expect("JSON")
+    out.stdout
 }
 
 /// A point and rotation turned over by a half turn about x, written out: (x, y, z) → (x, -y, -z).
@@ -149,16 +155,16 @@ fn a_cell_with_an_unknown_mounting_is_refused_with_its_key() {
 fn world_json(model: &Path, cell: &str) -> Value {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("world.json");
-    let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
-        .args(["world", model.to_str().unwrap(), "--cell", cell])
-        .args(["--format", "json", "--output", path.to_str().unwrap()])
-        .output()
-        .expect("framewright runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    framewright(&[
+        "world",
+        model.to_str().unwrap(),
+        "--cell",
+        cell,
+        "--format",
+        "json",
+        "--output",
+        path.to_str().unwrap(),
+    ]);
     serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
 }
 

@@ -383,13 +383,19 @@ impl<'a> WallRun<'a> {
                 }
             }
             Hold::Top(pads) => {
-                // On edge its top face is as wide as it is thick; lying flat, wider.
-                if thickness < pads.pad_width {
+                // On edge its top face is as wide as it is thick; fed flat (rules/world.dl:
+                // feeds_flat, every piece not on edge at its target), as it is wide.
+                let face = if piece.on_edge {
+                    thickness
+                } else {
+                    piece.size[1]
+                };
+                if face < pads.pad_width {
                     return Err(Refusal::new(
                         RefusalKind::NarrowerThanPads,
                         format!(
                             "its top face is {:.0} mm wide, narrower than the pads ({:.0} mm)",
-                            thickness * 1000.0,
+                            face * 1000.0,
                             pads.pad_width * 1000.0
                         ),
                     ));
