@@ -384,6 +384,10 @@ impl Tool {
     }
 }
 
+/// The kinds of gripper, as the messages about their keys name them.
+const SIDES: &str = "sides (holds = \"sides\", the default)";
+const TOP: &str = "top face (holds = \"top\")";
+
 /// The `[gripper]` table: jaws on the sides (`holds = "sides"`, the default) or pads on the top
 /// face (`holds = "top"`), each with its own keys.
 fn parse_gripper(
@@ -391,27 +395,28 @@ fn parse_gripper(
     bad: &dyn Fn(&str, &str, String) -> CellError,
 ) -> Result<Gripper, CellError> {
     let positive = |v: f64| v.is_finite() && v > 0.0;
-    let length = |key: &str, v: Option<f64>| match v {
-        Some(v) if positive(v) && v <= 10.0 => Ok(v),
-        Some(v) => Err(bad(
-            "gripper",
-            key,
-            format!("expected a length in m, positive and at most 10 m, got {v}"),
-        )),
-        None => Err(bad(
-            "gripper",
-            key,
-            format!(
-                "`{key}` is missing: a gripper holding the {} needs it",
-                if key == "pad_width" || key == "max_mass" {
-                    "top face (holds = \"top\")"
-                } else {
-                    "sides (holds = \"sides\", the default)"
-                }
-            ),
-        )),
+    let length = |key: &str, v: f64| {
+        if positive(v) && v <= 10.0 {
+            Ok(v)
+        } else {
+            Err(bad(
+                "gripper",
+                key,
+                format!("expected a length in m, positive and at most 10 m, got {v}"),
+            ))
+        }
     };
-    let spacing = length("spacing", Some(g.spacing))?;
+    // A key the kind of gripper needs (`holds` says which, for the message).
+    let needed = |key: &str, v: Option<f64>, holds: &str| {
+        v.ok_or_else(|| {
+            bad(
+                "gripper",
+                key,
+                format!("`{key}` is missing: a gripper holding the {holds} needs it"),
+            )
+        })
+    };
+    let spacing = length("spacing", g.spacing)?;
     if !g
         .max_lumber_section
         .iter()
@@ -439,10 +444,13 @@ fn parse_gripper(
                 "sides",
             )?;
             let jaws = Jaws {
-                stroke: length("stroke", g.stroke)?,
-                open_width: length("open_width", g.open_width)?,
-                closed_width: length("closed_width", g.closed_width)?,
-                jaw_depth: length("jaw_depth", g.jaw_depth)?,
+                stroke: length("stroke", needed("stroke", g.stroke, SIDES)?)?,
+                open_width: length("open_width", needed("open_width", g.open_width, SIDES)?)?,
+                closed_width: length(
+                    "closed_width",
+                    needed("closed_width", g.closed_width, SIDES)?,
+                )?,
+                jaw_depth: length("jaw_depth", needed("jaw_depth", g.jaw_depth, SIDES)?)?,
             };
             if jaws.closed_width >= jaws.open_width {
                 return Err(bad(
@@ -478,17 +486,16 @@ fn parse_gripper(
                 "top face",
             )?;
             let pads = TopPads {
-                pad_width: length("pad_width", g.pad_width)?,
-                max_mass: match g.max_mass {
-                    Some(m) if positive(m) && m <= 1e4 => m,
-                    Some(m) => {
+                pad_width: length("pad_width", needed("pad_width", g.pad_width, TOP)?)?,
+                max_mass: match needed("max_mass", g.max_mass, TOP)? {
+                    m if positive(m) && m <= 1e4 => m,
+                    m => {
                         return Err(bad(
                             "gripper",
                             "max_mass",
                             format!("expected a mass in kg, positive and at most 10,000, got {m}"),
                         ));
                     }
-                    None => length("max_mass", None)?,
                 },
             };
             Hold::Top(pads)

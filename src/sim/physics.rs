@@ -134,8 +134,9 @@ pub struct Physics {
     /// The nailer's parts on their slide (a tool with `[nailer] slide`): each collider and its
     /// pose in tool0 when the nailer is out (as the tool file places it).
     nailer: Vec<(ColliderHandle, Isometry3<f64>)>,
-    /// How far the slide takes the nailer back towards the flange (m), and whether it is out.
-    nailer_slide: (f64, bool),
+    /// Whether the nailer is out on its slide (`cell.tool.nailer_slide` says how far back it
+    /// stands otherwise).
+    nailer_out: bool,
     /// Every collider of the robot and its tool.
     pub robot_colliders: Vec<ColliderHandle>,
     /// The robot's colliders that move (not the base link's) and the body each belongs to.
@@ -527,7 +528,7 @@ impl Physics {
             tool,
             fingers,
             nailer,
-            nailer_slide: (cell.tool.nailer_slide, false),
+            nailer_out: false,
             robot_colliders,
             moving_shapes,
             sensor,
@@ -770,12 +771,12 @@ impl Physics {
 
     /// Runs the nailer out on its slide (`true`: where the tool file places it) or back.
     pub fn set_nailer(&mut self, out: bool) {
-        if self.nailer.is_empty() || self.nailer_slide.1 == out {
+        if self.nailer.is_empty() || self.nailer_out == out {
             return;
         }
         self.changed(true);
-        self.nailer_slide.1 = out;
-        let slide = self.nailer_slide.0;
+        self.nailer_out = out;
+        let slide = self.cell.tool.nailer_slide;
         for (c, origin) in &self.nailer {
             let pose = if out {
                 *origin

@@ -161,17 +161,13 @@ impl<'a> WallRun<'a> {
             // A piece laid over a nail's entry point (a cap plate on its top plate) would
             // shut the nailer out: the nails it covers are driven first, as a framing
             // station nails a plate before the next layer goes on.
-            let covered: Vec<&NailPlan> = nails
-                .iter()
-                .zip(driven.iter_mut())
-                .filter(|(nail, done)| {
-                    !**done && self.both_placed(nail) && self.covers(piece, nail)
-                })
-                .map(|(nail, done)| {
+            let mut covered: Vec<&NailPlan> = Vec::new();
+            for (nail, done) in nails.iter().zip(driven.iter_mut()) {
+                if !*done && self.both_placed(nail) && self.covers(piece, nail) {
                     *done = true;
-                    nail
-                })
-                .collect();
+                    covered.push(nail);
+                }
+            }
             if !covered.is_empty() {
                 let start = self.t;
                 self.nail_all(&covered);

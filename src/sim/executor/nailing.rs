@@ -11,6 +11,9 @@ use crate::sim::reach::{continuous_line_where, touches};
 use crate::sim::record::{NailOutcome, NailRecord, RobotStep, StepFor, failure_columns};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use rapier3d::parry::query::{Ray, RayCast};
+use rapier3d::parry::shape::Cuboid;
+use rapier3d::prelude::Vector;
 
 /// The nailer approaches along the nail line from this far back (m).
 pub(super) const NAIL_APPROACH: f64 = 0.10;
@@ -90,8 +93,11 @@ impl NailPlan {
 impl<'a> WallRun<'a> {
     /// Drives `nails` in their order; a nail whose plate or member was not placed is skipped.
     pub(super) fn nail_all(&mut self, nails: &[&NailPlan]) {
+        if nails.is_empty() {
+            return;
+        }
         let nail_tcp = *self.cell.tool.tcp("nail").expect("cells have a nail TCP");
-        self.slide_nailer(nails.first(), true);
+        self.slide_nailer(true);
         for &nail in nails {
             self.record.program.push(RobotStep::Begin(StepFor::Nail {
                 plate: nail.plate.clone(),
@@ -189,13 +195,13 @@ impl<'a> WallRun<'a> {
                 );
             }
         }
-        self.slide_nailer(nails.last(), false);
+        self.slide_nailer(false);
     }
 
-    /// Runs the nailer out on its slide before the first of a run of nails (`nail`) and back
-    /// after the last, where the tool has a slide; the slide moves in the gripper's time.
-    fn slide_nailer(&mut self, nail: Option<&&NailPlan>, out: bool) {
-        if self.cell.tool.nailer_slide <= 0.0 || nail.is_none() {
+    /// Runs the nailer out on its slide before a run of nails and back after it, where the
+    /// tool has a slide; the slide moves in the gripper's time.
+    fn slide_nailer(&mut self, out: bool) {
+        if self.cell.tool.nailer_slide <= 0.0 {
             return;
         }
         let seconds = self.cell.motion.grip_dwell;
@@ -390,25 +396,12 @@ fn nail_approaches(pose: Isometry3<f64>) -> impl Iterator<Item = Isometry3<f64>>
 }
 
 /// Whether the segment from `start` along `run` meets the axis-aligned box of half sizes
-/// `half` about the origin (the slab test: the segment's parameter interval inside every slab).
+/// `half` about the origin (parry's ray cast against a solid cuboid, the ray's time 0..1).
 fn segment_meets_box(start: &Point3<f64>, run: &Vector3<f64>, half: &[f64; 3]) -> bool {
-    let (mut enter, mut leave) = (0.0f64, 1.0f64);
-    for axis in 0..3 {
-        let (p, d, h) = (start[axis], run[axis], half[axis]);
-        if d.abs() < 1e-12 {
-            if p.abs() > h {
-                return false;
-            }
-            continue;
-        }
-        let (a, b) = ((-h - p) / d, (h - p) / d);
-        enter = enter.max(a.min(b));
-        leave = leave.min(a.max(b));
-        if enter > leave {
-            return false;
-        }
-    }
-    true
+    let v = |x: f64, y: f64, z: f64| Vector::new(x as f32, y as f32, z as f32);
+    let cuboid = Cuboid::new(v(half[0], half[1], half[2]));
+    let ray = Ray::new(v(start.x, start.y, start.z), v(run.x, run.y, run.z));
+    cuboid.intersects_local_ray(&ray, 1.0)
 }
 
 #[cfg(test)]
