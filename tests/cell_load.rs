@@ -376,3 +376,32 @@ fn a_nailer_slide_is_within_half_a_metre() {
         );
     }
 }
+
+/// The line's built-up headers arrive pre-assembled; the study's cells feed each ply; any
+/// other word is refused at its line with the two it takes.
+#[test]
+fn built_up_headers_are_plies_or_preassembled() {
+    use framewright::cell::BuiltUpHeaders;
+    let line = Cell::load("framing-line").unwrap();
+    assert_eq!(line.assembly.built_up_headers, BuiltUpHeaders::Preassembled);
+    for study in ["study-abb", "study-abb-track", "study-kuka"] {
+        let cell = Cell::load(study).unwrap();
+        assert_eq!(cell.assembly.built_up_headers, BuiltUpHeaders::Plies);
+    }
+    let text = include_str!("../robots/cells/framing-line.toml");
+    let bad = text.replace(
+        "built_up_headers = \"preassembled\"",
+        "built_up_headers = \"glued\"",
+    );
+    assert_ne!(bad, text);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("headers.toml");
+    std::fs::write(&path, bad).unwrap();
+    let msg = Cell::load(path.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        msg.contains("headers.toml:")
+            && msg.contains("assembly.built_up_headers")
+            && msg.contains("preassembled"),
+        "{msg}"
+    );
+}

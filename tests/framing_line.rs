@@ -175,17 +175,55 @@ fn axis(pose: &Value, axis: usize) -> Vector3<f64> {
     Vector3::from_fn(|row, _| m[row][axis].as_f64().unwrap())
 }
 
+/// The model's built-up headers: two plies of 2x10 on edge in the wall, 1/2 inch apart (the
+/// spacer between them is not modelled). (outer ply, inner ply, thickness across the wall
+/// from the outer ply's outer face to the inner ply's inner face, the gap between them.)
+fn built_up_headers(truth: &Value) -> Vec<(String, String, f64, f64)> {
+    let headers: Vec<&Value> = truth["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["role"] == "header")
+        .collect();
+    let mut out: Vec<(String, String, f64, f64)> = headers
+        .iter()
+        .filter(|h| h["role_detail"].as_str().unwrap().contains("inner"))
+        .map(|inner| {
+            let outer = headers
+                .iter()
+                .find(|h| {
+                    h["axis_start"][0] == inner["axis_start"][0]
+                        && h["global_id"] != inner["global_id"]
+                })
+                .unwrap();
+            let t = inner["thickness"].as_f64().unwrap();
+            let apart = (inner["axis_start"][1].as_f64().unwrap()
+                - outer["axis_start"][1].as_f64().unwrap())
+            .abs();
+            let id = |m: &Value| m["global_id"].as_str().unwrap().to_string();
+            (id(outer), id(inner), apart + t, apart - t)
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+fn door_window_wall() -> (PathBuf, Value) {
+    let model =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/synth_wall_door_window_in.ifc");
+    let truth: Value =
+        serde_json::from_str(&std::fs::read_to_string(model.with_extension("truth.json")).unwrap())
+            .unwrap();
+    (model, truth)
+}
+
 /// A gripper holding the top face cannot turn a piece over between pick and place: a piece
 /// that lies flat on the table at its target (a header on edge in the wall, whose width runs
 /// up the wall and so lies level when the wall is laid down) is fed flat to it, thickness up;
 /// the study's jaws take every piece on edge, width up.
 #[test]
 fn a_piece_flat_at_its_target_is_fed_flat_to_grippers_holding_the_top_face() {
-    let model =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/synth_wall_door_window_in.ifc");
-    let truth: Value =
-        serde_json::from_str(&std::fs::read_to_string(model.with_extension("truth.json")).unwrap())
-            .unwrap();
+    let (model, truth) = door_window_wall();
     let line = world_json(&model, "framing-line");
     let study = world_json(&model, "study-abb");
     // Lumber spawns on conveyor 1.
@@ -196,13 +234,13 @@ fn a_piece_flat_at_its_target_is_fed_flat_to_grippers_holding_the_top_face() {
         .translation
         .z;
     let mut flat = vec![];
-    for (p, q) in line["pieces"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .zip(study["pieces"].as_array().unwrap())
-    {
-        assert_eq!(p["id"], q["id"]);
+    for p in line["pieces"].as_array().unwrap() {
+        let q = study["pieces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|q| q["id"] == p["id"])
+            .unwrap();
         // Flat at its target: its width axis lies (nearly) level on the table.
         let lies_flat = axis(&p["framing_target"]["cell"], 1).z.abs() < 0.9;
         let up = if lies_flat { 2 } else { 1 };
@@ -228,25 +266,37 @@ fn a_piece_flat_at_its_target_is_fed_flat_to_grippers_holding_the_top_face() {
             );
         }
     }
-    // The model's headers are two plies of 2x10 on edge in the wall, 1/2 inch apart (the
-    // spacer between them is not modelled).
-    let headers: Vec<&Value> = truth["members"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter(|m| m["role"] == "header")
-        .collect();
-    let mut ids: Vec<String> = headers
-        .iter()
-        .map(|h| h["global_id"].as_str().unwrap().to_string())
-        .collect();
-    ids.sort();
+    // The headers are the flat pieces; on the line each arrives pre-assembled, fed as its
+    // outer ply.
+    let headers = built_up_headers(&truth);
+    let outer: Vec<String> = headers.iter().map(|h| h.0.clone()).collect();
     flat.sort();
-    assert_eq!(flat, ids, "the headers lie flat on the table");
+    assert_eq!(flat, outer, "the headers lie flat on the table");
+}
 
-    // The line frames every member but the inner plies: laid on the table, an inner ply's
-    // target lies the missing spacer's thickness above the outer ply, and released there it
-    // drops onto it by exactly that much.
+/// The line's built-up headers arrive nailed up (`built_up_headers = "preassembled"`): one
+/// member as thick as its plies and the spacer the model leaves out, set at once, so every
+/// ply is framed. Fed ply by ply, an inner ply's target lies the missing spacer's thickness
+/// above the outer ply, and released there it drops onto it by exactly that much.
+#[test]
+fn a_built_up_header_is_set_preassembled_and_fed_ply_by_ply_its_inner_ply_drops_by_the_spacer() {
+    let (model, truth) = door_window_wall();
+    let headers = built_up_headers(&truth);
+    assert_eq!(headers.len(), 2);
+    let line = world_json(&model, "framing-line");
+    let pieces = line["pieces"].as_array().unwrap();
+    for (outer, inner, thickness, _) in &headers {
+        assert!(
+            pieces.iter().all(|p| p["id"] != inner.as_str()),
+            "{inner} fed alone"
+        );
+        let lead = pieces.iter().find(|p| p["id"] == outer.as_str()).unwrap();
+        let t = lead["size"][2].as_f64().unwrap();
+        assert!(
+            (t - thickness).abs() < 1e-6,
+            "{outer}: {t} m thick, plies {thickness} m"
+        );
+    }
     let sim = simulate_json(&model, "framing-line");
     let elements = sim["elements"].as_array().unwrap();
     assert_eq!(
@@ -254,23 +304,31 @@ fn a_piece_flat_at_its_target_is_fed_flat_to_grippers_holding_the_top_face() {
         truth["counts"]["members"].as_u64().unwrap()
     );
     for e in elements {
-        let inner = headers.iter().find(|h| {
-            h["global_id"] == e["id"] && h["role_detail"].as_str().unwrap().contains("inner")
-        });
-        let Some(inner) = inner else {
+        assert_eq!(e["framing"]["status"], "framed", "{e}");
+    }
+
+    // The same line, each ply on its own.
+    let dir = tempfile::tempdir().unwrap();
+    let cell = dir.path().join("plies.toml");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/cells/framing-line.toml"),
+    )
+    .unwrap();
+    assert!(text.contains("built_up_headers = \"preassembled\""));
+    std::fs::write(
+        &cell,
+        text.replace(
+            "built_up_headers = \"preassembled\"",
+            "built_up_headers = \"plies\"",
+        ),
+    )
+    .unwrap();
+    let sim = simulate_json(&model, cell.to_str().unwrap());
+    for e in sim["elements"].as_array().unwrap() {
+        let Some((_, _, _, gap)) = headers.iter().find(|h| h.1 == e["id"].as_str().unwrap()) else {
             assert_eq!(e["framing"]["status"], "framed", "{e}");
             continue;
         };
-        let outer = headers
-            .iter()
-            .find(|h| {
-                h["axis_start"][0] == inner["axis_start"][0] && h["global_id"] != inner["global_id"]
-            })
-            .unwrap();
-        let gap = (inner["axis_start"][1].as_f64().unwrap()
-            - outer["axis_start"][1].as_f64().unwrap())
-        .abs()
-            - inner["thickness"].as_f64().unwrap();
         let reason = e["framing"]["reasons"][0]["message"].as_str().unwrap();
         let mm: f64 = reason
             .strip_prefix("came to rest ")

@@ -96,6 +96,7 @@ struct AssemblySection {
     orientation: Orientation,
     centre_y: f64,
     surface_z: f64,
+    built_up_headers: BuiltUpHeaders,
 }
 
 impl Default for AssemblySection {
@@ -106,6 +107,7 @@ impl Default for AssemblySection {
             orientation: Orientation::Parallel,
             centre_y: 0.0,
             surface_z: 0.0,
+            built_up_headers: BuiltUpHeaders::Plies,
         }
     }
 }
@@ -225,6 +227,26 @@ pub enum Orientation {
     Perpendicular,
 }
 
+/// How a built-up header (plies stacked across the wall, spacers between) reaches the table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BuiltUpHeaders {
+    /// Each ply is fed and placed on its own, as the model has it.
+    #[default]
+    Plies,
+    /// Nailed up with its spacers upstream (a header station) and fed as one member.
+    Preassembled,
+}
+
+impl BuiltUpHeaders {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BuiltUpHeaders::Plies => "plies",
+            BuiltUpHeaders::Preassembled => "preassembled",
+        }
+    }
+}
+
 fn speed_1() -> f64 {
     0.05
 }
@@ -325,6 +347,7 @@ pub struct Assembly {
     pub centre_y: f64,
     /// Height (m) of the surface the wall lies on.
     pub surface_z: f64,
+    pub built_up_headers: BuiltUpHeaders,
 }
 
 /// A belt conveyor. `pose`: centre of the belt's top surface, x along the travel direction.
@@ -800,6 +823,7 @@ impl Cell {
                 orientation: a.orientation,
                 centre_y: a.centre_y,
                 surface_z: a.surface_z,
+                built_up_headers: a.built_up_headers,
             },
             conveyor1,
             conveyor2,

@@ -27,8 +27,8 @@ pub use builtin::{cell_names, robot_names, tool_names};
 pub use error::CellError;
 pub use ik::{IkFailure, IkOptions};
 pub use layout::{
-    Arrangement, Assembly, Cell, Conveyor, Creep, Floor, Motion, OffsetX, Orientation, Pick,
-    ToolTable, TouchSensor,
+    Arrangement, Assembly, BuiltUpHeaders, Cell, Conveyor, Creep, Floor, Motion, OffsetX,
+    Orientation, Pick, ToolTable, TouchSensor,
 };
 pub use meta::{OpwParams, RobotMeta};
 pub use panels::{PanelLimits, PanelMode};

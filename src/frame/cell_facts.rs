@@ -28,6 +28,7 @@
 //! | `carry_length` | value | the longest piece the conveyors carry (conveyor 2's length, conveyor 1's width side by side or length end to end) |
 //! | `panel_max_length`, `panel_max_height`, `panel_max_mass`, `panel_min_length`, `panel_cap_lap` | value | `[panels]` of the cell file (m, kg) |
 //! | `gripper_holds` | choice | `sides` (jaws on the piece's side faces) or `top` (pads on its top face); absent for a tool without grippers |
+//! | `built_up_headers` | choice | `plies` (each ply fed on its own) or `preassembled` (a built-up header fed as one member, `rules/world.dl`) |
 //! | `panels` | choice | `auto` (walls split into panels by `rules/panels.dl`) or `off` (`--panels off`: every wall one panel) |
 //! | `cell_name`, `robot_name`, `tool_name` | choice | names, for messages |
 
@@ -123,6 +124,7 @@ pub fn cell_facts(cell: &Cell) -> Facts {
             },
         );
     }
+    choice("built_up_headers", a.built_up_headers.as_str());
     choice("panels", cell.panel_mode.as_str());
     choice("cell_name", &cell.name);
     choice("robot_name", &cell.robot.name);

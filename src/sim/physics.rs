@@ -1382,6 +1382,7 @@ mod tests {
             target_robot: pose,
             target_cell: pose,
             on_edge: true,
+            plies: Vec::new(),
         };
         (piece, pose)
     }

@@ -125,6 +125,10 @@ struct PieceJson<'a> {
     beyond_belt: Option<f64>,
     on_edge: bool,
     framing_target: TargetJson,
+    /// The other plies of the pre-assembled member it is fed as (its size and target are the
+    /// member's); omitted for a piece fed alone.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    plies: Vec<&'a str>,
 }
 
 /// The scene as pretty-printed JSON with a final newline.
@@ -202,6 +206,7 @@ pub fn to_json(scene: &Scene) -> String {
                     robot: pose(&p.target_robot),
                     cell: pose(&p.target_cell),
                 },
+                plies: p.plies.iter().map(|q| q.id.as_str()).collect(),
             })
             .collect(),
         warnings: &scene.warnings,

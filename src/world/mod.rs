@@ -19,4 +19,4 @@ pub use relations::{
     FramingTarget, Spawn, WorldPiece, framing_target_walls, framing_targets, spawn_beyond_belt,
     spawns, world_pieces,
 };
-pub use scene::{Scene, SceneConveyor, ScenePiece, SceneRobot, SceneWall, webots_proto};
+pub use scene::{Scene, SceneConveyor, ScenePiece, ScenePly, SceneRobot, SceneWall, webots_proto};

@@ -33,7 +33,8 @@ pub struct SceneConveyor {
     pub conveyor: Conveyor,
 }
 
-/// A wall: its laid-flat frame in the robot frame and its pieces in spawn order.
+/// A wall: its laid-flat frame in the robot frame and its pieces in spawn order (the plies
+/// of a pre-assembled member after its lead, with no `ScenePiece` of their own).
 #[derive(Debug, Clone)]
 pub struct SceneWall {
     pub id: String,
@@ -69,6 +70,19 @@ pub struct ScenePiece {
     /// Whether it lies on edge (width vertical) at its target; false for pieces that lie flat
     /// there, such as headers set on edge in the wall (`framing_flat`).
     pub on_edge: bool,
+    /// The other plies of a pre-assembled member this piece leads (`fed_with`): they ride in
+    /// it, its size and target being the whole member's.
+    pub plies: Vec<ScenePly>,
+}
+
+/// A ply fed inside a pre-assembled member: not a body of its own.
+#[derive(Debug, Clone)]
+pub struct ScenePly {
+    pub id: String,
+    /// Length, width, thickness (m) of the ply alone.
+    pub size: [f64; 3],
+    /// Its own framing target (body frame), cell frame.
+    pub target_cell: Isometry3<f64>,
 }
 
 /// Everything a simulator needs to build the cell and its lumber.
@@ -152,6 +166,35 @@ impl Scene {
             .collect();
         let products: BTreeMap<&str, _> =
             model.pieces().iter().map(|p| (p.id.as_str(), p)).collect();
+        let piece_sizes: BTreeMap<&str, [f64; 3]> = r
+            .get("piece_size")
+            .iter()
+            .filter_map(|t| {
+                let f = |k: usize| t.get(k).and_then(|v| v.as_float());
+                Some((t.first()?.as_symbol()?, [f(1)?, f(2)?, f(3)?]))
+            })
+            .collect();
+        let mut plies: BTreeMap<&str, Vec<ScenePly>> = BTreeMap::new();
+        for t in r.get("fed_with") {
+            let (Some(ply), Some(lead)) = (t[0].as_symbol(), t[1].as_symbol()) else {
+                continue;
+            };
+            let incomplete = |missing| WorldError::Incomplete {
+                piece: ply.to_string(),
+                missing,
+            };
+            let (_, target) = targets
+                .get(ply)
+                .ok_or_else(|| incomplete("framing target (framing_target)"))?;
+            let size = piece_sizes
+                .get(ply)
+                .ok_or_else(|| incomplete("size (piece_size)"))?;
+            plies.entry(lead).or_default().push(ScenePly {
+                id: ply.to_string(),
+                size: *size,
+                target_cell: cell.robot_base * target,
+            });
+        }
 
         let mut pieces = Vec::new();
         for s in spawns(r)? {
@@ -184,6 +227,7 @@ impl Scene {
                 target_robot: target,
                 target_cell: cell.robot_base * target,
                 on_edge: !flat.contains(s.piece.as_str()),
+                plies: plies.remove(s.piece.as_str()).unwrap_or_default(),
                 id: s.piece,
             });
         }
@@ -191,10 +235,13 @@ impl Scene {
         let walls = framing_target_walls(r)?
             .into_iter()
             .map(|(id, wall_to_robot)| SceneWall {
+                // A pre-assembled member's plies follow its lead: elements, not bodies.
                 pieces: pieces
                     .iter()
                     .filter(|p| p.wall == id)
-                    .map(|p| p.id.clone())
+                    .flat_map(|p| {
+                        std::iter::once(p.id.clone()).chain(p.plies.iter().map(|q| q.id.clone()))
+                    })
                     .collect(),
                 id,
                 wall_to_robot,

@@ -21,7 +21,16 @@ impl<'a> WallRun<'a> {
 
     /// Rest poses against targets, and every fired nail's as-built point and member check.
     pub(super) fn measure(&mut self, nails: &[NailPlan]) {
-        let poses = self.phys.lumber_poses();
+        let mut poses = self.phys.lumber_poses();
+        // A ply of a pre-assembled member moved as its member did (the lead's body).
+        for (ply, (lead, target)) in &self.plies {
+            if let (Some(actual), Some(planned)) = (poses.get(lead), self.placed.get(lead))
+                && self.placed.contains_key(ply)
+            {
+                let moved = actual * nearest_symmetry(planned, actual).inverse();
+                poses.insert(ply.clone(), moved * target);
+            }
+        }
         let mut delta: BTreeMap<String, Isometry3<f64>> = BTreeMap::new();
         for (id, target) in &self.placed {
             let Some(actual) = poses.get(id) else {
@@ -37,15 +46,10 @@ impl<'a> WallRun<'a> {
                 position_error,
                 angle_error,
             });
-            let best = box_symmetries()
-                .into_iter()
-                .min_by(|a, b| {
-                    let ea = (target * a).rotation.angle_to(&actual.rotation);
-                    let eb = (target * b).rotation.angle_to(&actual.rotation);
-                    ea.total_cmp(&eb)
-                })
-                .unwrap_or_else(Isometry3::identity);
-            delta.insert(id.clone(), actual * (target * best).inverse());
+            delta.insert(
+                id.clone(),
+                actual * nearest_symmetry(target, actual).inverse(),
+            );
         }
         let sizes: BTreeMap<&str, [f64; 3]> = self
             .pieces
@@ -101,6 +105,20 @@ impl<'a> WallRun<'a> {
             );
         }
     }
+}
+
+/// The target turned by the box symmetry that brings it nearest `actual`'s orientation (a box
+/// has no preferred sign of its axes).
+fn nearest_symmetry(target: &Isometry3<f64>, actual: &Isometry3<f64>) -> Isometry3<f64> {
+    box_symmetries()
+        .into_iter()
+        .map(|s| target * s)
+        .min_by(|a, b| {
+            let ea = a.rotation.angle_to(&actual.rotation);
+            let eb = b.rotation.angle_to(&actual.rotation);
+            ea.total_cmp(&eb)
+        })
+        .unwrap_or(*target)
 }
 
 /// How far a nail reaches past the plate into the member (m) for the check below.

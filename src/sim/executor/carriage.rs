@@ -12,6 +12,8 @@ use std::borrow::Cow;
 /// inside the arm's reach (m); the nearest comfortable position is taken, else the one
 /// with the most to spare.
 const CARRIAGE_MARGIN: f64 = 0.15;
+/// Where no position is comfortable, a farther one is taken only for this much more margin (m).
+const MARGIN_WORTH_MOVING: f64 = 0.005;
 
 impl<'a> WallRun<'a> {
     /// The cell with the carriage at `s` (the run's own cell when it stands there already).
@@ -66,7 +68,9 @@ impl<'a> WallRun<'a> {
                 }
                 None if margin >= CARRIAGE_MARGIN => return Ok(s),
                 None => {
-                    if best.is_none_or(|b| margin > b.1) {
+                    // Positions come nearest first: a farther one must be worth its travel
+                    // (equal margins abeam of the work differ only by rounding).
+                    if best.is_none_or(|b| margin > b.1 + MARGIN_WORTH_MOVING) {
                         best = Some((s, margin));
                     }
                 }

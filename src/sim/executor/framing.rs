@@ -8,7 +8,7 @@ use crate::sim::physics::GRAVITY;
 use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
 use crate::sim::record::{IkRecord, Refusal, RefusalKind, RobotStep, StepFor};
 use crate::world::ScenePiece;
-use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// Height above the pick and place poses the gripper approaches from (m).
 pub(super) const CLEARANCE: f64 = 0.25;
@@ -250,6 +250,9 @@ impl<'a> WallRun<'a> {
         if ok
             && let Err(failure) = carried
                 .and_then(|()| self.move_to(&q_above_place, &grip, &[], self.transfer_speed()))
+            && self
+                .above_from_abeam(&place, &grip, &q_above_place)
+                .is_err()
         {
             // No way to the target with the piece: the arm lets go where it is and the piece
             // is taken out of the cell.
@@ -305,7 +308,38 @@ impl<'a> WallRun<'a> {
             // Settled on the fixture: from now on the fixture holds it.
             self.phys.clamp(id);
             self.placed.insert(id.to_string(), plan.target);
+            // A pre-assembled member's other plies are in place with it.
+            for ply in &piece.plies {
+                self.placed.insert(ply.id.clone(), ply.target_cell);
+            }
         }
+    }
+
+    /// On a track, where the way above the place pose is blocked from where the carriage
+    /// stands: the carriage abeam of the place pose instead (the arm reaches down over the
+    /// work rather than across it), and the arm above the pose from there. Err where that
+    /// is the same position or no clear way either.
+    fn above_from_abeam(
+        &mut self,
+        place: &Isometry3<f64>,
+        grip: &Isometry3<f64>,
+        seed: &[f64],
+    ) -> Result<(), IkFailure> {
+        let Some(track) = self.cell.track else {
+            return Err(IkFailure::InvalidPose);
+        };
+        let above = raise(place, CLEARANCE);
+        let s = self.carriage_for(
+            track.abeam(&Point3::from(place.translation.vector)),
+            &[(*place, *grip), (above, *grip)],
+        )?;
+        if (s - self.cell.carriage()).abs() < 1e-9 {
+            return Err(IkFailure::InvalidPose);
+        }
+        let (q_above, _) =
+            continuous_line(&self.cell_at(s), seed, &above, place, grip, LINE_SAMPLES)?;
+        self.move_carriage(s, grip, &[])?;
+        self.move_to(&q_above, grip, &[], self.transfer_speed())
     }
 
     /// Where the grip TCP holds `piece` at its release: metres along the piece from its

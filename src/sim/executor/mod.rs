@@ -51,8 +51,11 @@ pub struct WallRun<'a> {
     phys: Physics,
     wall_cell: Isometry3<f64>,
     pieces: Vec<&'a ScenePiece>,
-    /// Each piece's size by id (the feeder looks them up every step).
+    /// Each piece's size by id (the feeder looks them up every step), plies included.
     sizes: HashMap<String, [f64; 3]>,
+    /// Plies riding in a pre-assembled member: the member's lead (their body) and the ply's
+    /// own target (cell frame).
+    plies: HashMap<String, (String, Isometry3<f64>)>,
     /// When the feeder looks at conveyor 1 next: (`belt_state`, time in s).
     feed_due: Option<((u64, usize), f64)>,
     /// When the transfer arm looks at conveyor 1's rail next (as `feed_due`).
@@ -104,7 +107,21 @@ impl<'a> WallRun<'a> {
             options,
             phys,
             wall_cell: cell.robot_base * wall.wall_to_robot,
-            sizes: pieces.iter().map(|p| (p.id.clone(), p.size)).collect(),
+            sizes: pieces
+                .iter()
+                .flat_map(|p| {
+                    std::iter::once((p.id.clone(), p.size))
+                        .chain(p.plies.iter().map(|ply| (ply.id.clone(), ply.size)))
+                })
+                .collect(),
+            plies: pieces
+                .iter()
+                .flat_map(|p| {
+                    p.plies
+                        .iter()
+                        .map(|ply| (ply.id.clone(), (p.id.clone(), ply.target_cell)))
+                })
+                .collect(),
             feed_due: None,
             transfer_due: None,
             pieces,
@@ -322,9 +339,17 @@ impl<'a> WallRun<'a> {
         outcome
     }
 
+    /// The physics body a piece rides in: its own, or its pre-assembled member's.
+    fn body<'s>(&'s self, id: &'s str) -> &'s str {
+        self.plies.get(id).map_or(id, |(lead, _)| lead.as_str())
+    }
+
     fn begin(&mut self, piece: &str, op: &'static str, may_touch: &[&str]) -> f64 {
-        let mut allowed: Vec<String> = may_touch.iter().map(|p| format!("piece {p}")).collect();
-        allowed.push(format!("piece {piece}"));
+        let mut allowed: Vec<String> = may_touch
+            .iter()
+            .map(|p| format!("piece {}", self.body(p)))
+            .collect();
+        allowed.push(format!("piece {}", self.body(piece)));
         self.current = Some((piece.to_string(), op, allowed));
         self.t
     }

@@ -1,7 +1,7 @@
 //! Nailing: drive every nail of the plan whose plate and member were placed.
 
 use super::as_built::nail_runs_into;
-use super::{WallRun, failure_score};
+use super::{WallRun, failure_score, raise};
 use crate::cell::Cell;
 use crate::cell::IkFailure;
 use crate::cell::tcp_poses::{nail_lines, nail_pose, nail_rolls, retreat};
@@ -30,6 +30,9 @@ pub(super) const NOSE_GAP: f64 = 0.002;
 const COVER_CLEARANCE: f64 = 0.01;
 /// ...along this much of the line: the nailer's nose and its straight approach (m).
 const COVER_DEPTH: f64 = NAIL_APPROACH + 0.05;
+/// How far the tool lifts straight up out of a tight spot before it tries the way to the next
+/// nail again (m): well clear of lumber on edge on the table.
+const LIFT_OUT: f64 = 0.25;
 
 /// How many approach poses of one nail the executor tries to move to before giving up.
 const MAX_PATH_TRIES: usize = 3;
@@ -155,7 +158,11 @@ impl<'a> WallRun<'a> {
                 .is_ok();
             let fired_at = self.t;
             if reached {
-                self.phys.nail(&nail.plate, &nail.member);
+                let plate = self.body(&nail.plate).to_string();
+                let member = self.body(&nail.member).to_string();
+                if plate != member {
+                    self.phys.nail(&plate, &member);
+                }
                 self.record.program.push(RobotStep::Fire);
                 self.dwell(self.cell.motion.fire_dwell);
             }
@@ -249,28 +256,59 @@ impl<'a> WallRun<'a> {
                     nail_approaches(pose).map(move |back| (pose, back, driven, lean))
                 })
         });
-        for (pose, back, driven, lean) in candidates {
+        // On a track the carriage stays where it is while that reaches; where the way from
+        // there is blocked, it stands abeam of the nail instead (over the work, the arm
+        // reaches down rather than across the frame).
+        let abeam = self.cell.track.map(|t| t.abeam(&point));
+        let tries =
+            candidates.flat_map(|c| std::iter::once((c, None)).chain(abeam.map(|a| (c, Some(a)))));
+        let mut blocked_at: Option<f64> = None;
+        let mut lifted = false;
+        for ((pose, back, driven, lean), from) in tries {
+            if from.is_some() && blocked_at.is_none() {
+                // The way from where the carriage stands was not tried or not blocked.
+                continue;
+            }
             let attempt = self
-                .carriage_for(self.cell.carriage(), &[(back, nail_tcp), (pose, nail_tcp)])
+                .carriage_for(
+                    from.unwrap_or(self.cell.carriage()),
+                    &[(back, nail_tcp), (pose, nail_tcp)],
+                )
                 .and_then(|s| {
                     let at = self.cell_at(s);
                     self.clear_nail_branch(&at, nail, (&back, &pose), &nail_tcp)
                         .map(|qa| (qa, s))
                 });
+            blocked_at = None;
             match attempt {
+                Ok((_, s)) if from.is_some() && (s - self.cell.carriage()).abs() < 1e-9 => {
+                    // Abeam leads back to where the carriage stands: blocked as before.
+                    continue;
+                }
                 Ok((q_back, s)) => {
                     // Go to the approach pose; where no way leads there, try the next
                     // pose (a few at most: each costs the planner's budget).
                     let begun = *start.get_or_insert_with(|| {
                         self.begin(&nail.plate, "nail", &[nail.member.as_str()])
                     });
-                    if let Err(f) = self
+                    let mut way = self
                         .move_carriage(s, &nail_tcp, &[])
-                        .and_then(|()| self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()))
-                    {
+                        .and_then(|()| self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()));
+                    if way.is_err() && !lifted {
+                        // Blocked from a tight spot (the nose down among the pieces after
+                        // the last nail): once per nail, lift straight out and try again.
+                        lifted = true;
+                        if self.lift_out(&nail_tcp).is_ok() {
+                            way = self.move_carriage(s, &nail_tcp, &[]).and_then(|()| {
+                                self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed())
+                            });
+                        }
+                    }
+                    if let Err(f) = way {
                         // Reachable and clear, only the way there is blocked: the most
                         // telling miss.
                         miss = Some((-2.0, f));
+                        blocked_at = Some(s);
                         path_tries += 1;
                         if path_tries == MAX_PATH_TRIES {
                             break;
@@ -298,6 +336,20 @@ impl<'a> WallRun<'a> {
         Err((start, miss.map_or(IkFailure::InvalidPose, |m| m.1)))
     }
 
+    /// Lifts the tool straight up by LIFT_OUT from where it is, at the nailer's approach speed.
+    fn lift_out(&mut self, tcp: &Isometry3<f64>) -> Result<(), IkFailure> {
+        let here = self.cell.robot_base * self.cell.robot.fk_tip(&self.q) * tcp;
+        self.run_line(
+            &LinearMove::new(
+                here,
+                raise(&here, LIFT_OUT),
+                self.nail_approach_speed(),
+                self.cell.motion.line_accel,
+            ),
+            tcp,
+        )
+    }
+
     /// The joints at `back` of the first IK solution there (nearest the arm's joints first)
     /// whose straight line to `fire` exists without a jump and touches nothing at either
     /// end: firing, the nose may touch the plate and the member; at `back` nothing may.
@@ -308,7 +360,7 @@ impl<'a> WallRun<'a> {
         (back, fire): (&Isometry3<f64>, &Isometry3<f64>),
         tcp: &Isometry3<f64>,
     ) -> Result<Vec<f64>, IkFailure> {
-        let ignore = [nail.plate.as_str(), nail.member.as_str()];
+        let ignore = [self.body(&nail.plate), self.body(&nail.member)];
         // A solution that got there but collides is the more telling miss.
         let collides = |q_back: &[f64], q_fire: &[f64]| {
             touches(&self.phys, at, q_fire, None, &ignore, 0.0)
