@@ -380,3 +380,111 @@ fn short_blocks_meet_the_end_stop_slowly_and_stay_on_edge() {
         .collect();
     assert_eq!(toppled.len(), 3, "{toppled:?}");
 }
+
+/// A model that holds members twice (the AutoTimber generator wrote one of its walls twice
+/// over): each copy is named in a warning and built once, as its original, so it shares its
+/// original's verdict and is never fed on its own. The copies are found here from the plan's
+/// members (same wall, axis and section to the millimetre), apart from the rules.
+#[test]
+fn a_member_the_model_holds_twice_is_named_and_built_once() {
+    let Some(model) = common::shared_path(
+        "ifc-realworld/timber_autotimber-xbim-generated_outer-walls-5-framed_IFC4_feet.ifc",
+    ) else {
+        return;
+    };
+    let model = model.to_str().unwrap();
+    let plan: Value = serde_json::from_slice(&framewright(&[
+        "plan",
+        model,
+        "--cell",
+        "framing-line",
+        "--json",
+    ]))
+    .unwrap();
+    let mm = |v: &Value| -> Vec<i64> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| (x.as_f64().unwrap() * 1000.0).round() as i64)
+            .collect()
+    };
+    let mut twins: std::collections::BTreeMap<(String, Vec<i64>), Vec<String>> = Default::default();
+    for m in plan["members"].as_array().unwrap() {
+        let mut ends = [mm(&m["axis_start"]), mm(&m["axis_end"])];
+        ends.sort();
+        let mut key = ends.concat();
+        key.push((m["width"].as_f64().unwrap() * 1000.0).round() as i64);
+        key.push((m["thickness"].as_f64().unwrap() * 1000.0).round() as i64);
+        twins
+            .entry((m["wall_id"].as_str().unwrap().to_string(), key))
+            .or_default()
+            .push(m["id"].as_str().unwrap().to_string());
+    }
+    let mut copies: Vec<(String, String)> = vec![];
+    for ids in twins.values_mut().filter(|ids| ids.len() > 1) {
+        ids.sort();
+        copies.extend(ids[1..].iter().map(|c| (c.clone(), ids[0].clone())));
+    }
+    copies.sort();
+    assert!(copies.len() >= 100, "{} copies", copies.len());
+    let mut named: Vec<(String, String)> = plan["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| {
+            // "SUBJECT: piece COPY duplicates ORIGINAL (…)"; the subject of a wall's key
+            // piece reads as the wall.
+            let (_, rest) = w.as_str()?.split_once(": piece ")?;
+            let (copy, rest) = rest.split_once(" duplicates ")?;
+            Some((copy.to_string(), rest.split(' ').next()?.to_string()))
+        })
+        .collect();
+    named.sort();
+    assert_eq!(named, copies);
+
+    let wall = common::wall_holding(&plan, &copies[0].0)["wall_id"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let sim = simulate_json_with(Path::new(model), "framing-line", &["--wall", &wall]);
+    let elements = sim["elements"].as_array().unwrap();
+    let status = |id: &str| {
+        elements
+            .iter()
+            .find(|e| e["id"] == id)
+            .map(|e| e["framing"]["status"].clone())
+            .unwrap_or_else(|| panic!("{id} has no verdict"))
+    };
+    let mut framed = 0;
+    for (copy, original) in copies
+        .iter()
+        .filter(|(c, _)| common::wall_holding(&plan, c)["wall_id"] == wall.as_str())
+    {
+        // A plate cut at the panel breaks is elements `ID~k`: each segment as its original's.
+        let segments: Vec<&str> = elements
+            .iter()
+            .filter_map(|e| e["id"].as_str())
+            .filter(|id| {
+                *id == copy
+                    || id
+                        .strip_prefix(copy.as_str())
+                        .is_some_and(|r| r.starts_with('~'))
+            })
+            .collect();
+        assert!(!segments.is_empty(), "{copy} has no verdict");
+        for segment in segments {
+            let twin = segment.replacen(copy.as_str(), original, 1);
+            assert_eq!(status(segment), status(&twin), "{segment} as {twin}");
+            framed += usize::from(status(segment) == "framed");
+        }
+    }
+    assert!(framed > 0);
+    let world = world_json(Path::new(model), "framing-line");
+    let fed: Vec<&str> = world["pieces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["id"].as_str().unwrap())
+        .collect();
+    assert!(copies.iter().all(|(c, _)| !fed.contains(&c.as_str())));
+}

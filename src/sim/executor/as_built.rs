@@ -51,11 +51,8 @@ impl<'a> WallRun<'a> {
                 actual * nearest_symmetry(target, actual).inverse(),
             );
         }
-        let sizes: BTreeMap<&str, [f64; 3]> = self
-            .pieces
-            .iter()
-            .map(|p| (p.id.as_str(), p.size))
-            .collect();
+        // Plies and copies riding in a fed piece by their own sizes.
+        let sizes = &self.sizes;
         let wall_inv = self.wall_cell.inverse();
         for record in &mut self.record.nails {
             let NailOutcome::Fired {
