@@ -212,3 +212,30 @@ pub fn spawn_beyond_belt(r: &Reasoned) -> Result<BTreeMap<String, f64>, WorldErr
         .map(|t| Ok((symbol(REL, t, 0, WHAT)?, float(REL, t, 1, WHAT)?)))
         .collect()
 }
+
+/// Every piece riding inside another that is fed (`fed_with`: a pre-assembled member's plies,
+/// a duplicated member's copy), as (piece, the piece fed), sorted.
+pub fn fed_with(r: &Reasoned) -> Result<Vec<(String, String)>, WorldError> {
+    const REL: &str = "fed_with";
+    const WHAT: &str = "(p: symbol, lead: symbol)";
+    let mut rows: Vec<(String, String)> = r
+        .get(REL)
+        .iter()
+        .map(|t| Ok((symbol(REL, t, 0, WHAT)?, symbol(REL, t, 1, WHAT)?)))
+        .collect::<Result<_, WorldError>>()?;
+    rows.sort();
+    Ok(rows)
+}
+
+/// Every piece's box size (length, width, thickness; m) by id (`piece_size`).
+pub fn piece_sizes(r: &Reasoned) -> Result<BTreeMap<String, [f64; 3]>, WorldError> {
+    const REL: &str = "piece_size";
+    const WHAT: &str = "(p: symbol, length: float, width: float, thickness: float)";
+    r.get(REL)
+        .iter()
+        .map(|t| {
+            let f = |k| float(REL, t, k, WHAT);
+            Ok((symbol(REL, t, 0, WHAT)?, [f(1)?, f(2)?, f(3)?]))
+        })
+        .collect()
+}

@@ -2,7 +2,8 @@
 
 use super::WorldError;
 use super::relations::{
-    framing_target_walls, framing_targets, spawn_beyond_belt, spawns, world_pieces,
+    fed_with, framing_target_walls, framing_targets, piece_sizes, spawn_beyond_belt, spawns,
+    world_pieces,
 };
 use crate::cell::{Cell, Conveyor, Floor, PlacedShape, ToolTable, TouchSensor};
 use crate::frame::{Reasoned, RuleEngine, cell_facts, model_facts, reason};
@@ -166,33 +167,24 @@ impl Scene {
             .collect();
         let products: BTreeMap<&str, _> =
             model.pieces().iter().map(|p| (p.id.as_str(), p)).collect();
-        let piece_sizes: BTreeMap<&str, [f64; 3]> = r
-            .get("piece_size")
-            .iter()
-            .filter_map(|t| {
-                let f = |k: usize| t.get(k).and_then(|v| v.as_float());
-                Some((t.first()?.as_symbol()?, [f(1)?, f(2)?, f(3)?]))
-            })
-            .collect();
-        let mut plies: BTreeMap<&str, Vec<ScenePly>> = BTreeMap::new();
-        for t in r.get("fed_with") {
-            let (Some(ply), Some(lead)) = (t[0].as_symbol(), t[1].as_symbol()) else {
-                continue;
-            };
+        let piece_sizes = piece_sizes(r)?;
+        let mut plies: BTreeMap<String, Vec<ScenePly>> = BTreeMap::new();
+        for (ply, lead) in fed_with(r)? {
             let incomplete = |missing| WorldError::Incomplete {
-                piece: ply.to_string(),
+                piece: ply.clone(),
                 missing,
             };
             let (_, target) = targets
-                .get(ply)
+                .get(&ply)
                 .ok_or_else(|| incomplete("framing target (framing_target)"))?;
-            let size = piece_sizes
-                .get(ply)
+            let size = *piece_sizes
+                .get(&ply)
                 .ok_or_else(|| incomplete("size (piece_size)"))?;
+            let target_cell = cell.robot_base * target;
             plies.entry(lead).or_default().push(ScenePly {
-                id: ply.to_string(),
-                size: *size,
-                target_cell: cell.robot_base * target,
+                id: ply,
+                size,
+                target_cell,
             });
         }
 
@@ -227,7 +219,7 @@ impl Scene {
                 target_robot: target,
                 target_cell: cell.robot_base * target,
                 on_edge: !flat.contains(s.piece.as_str()),
-                plies: plies.remove(s.piece.as_str()).unwrap_or_default(),
+                plies: plies.remove(&s.piece).unwrap_or_default(),
                 id: s.piece,
             });
         }

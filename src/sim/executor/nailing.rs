@@ -262,10 +262,10 @@ impl<'a> WallRun<'a> {
         let abeam = self.cell.track.map(|t| t.abeam(&point));
         let tries =
             candidates.flat_map(|c| std::iter::once((c, None)).chain(abeam.map(|a| (c, Some(a)))));
-        let mut blocked_at: Option<f64> = None;
+        let mut blocked = false;
         let mut lifted = false;
         for ((pose, back, driven, lean), from) in tries {
-            if from.is_some() && blocked_at.is_none() {
+            if from.is_some() && !blocked {
                 // The way from where the carriage stands was not tried or not blocked.
                 continue;
             }
@@ -279,7 +279,7 @@ impl<'a> WallRun<'a> {
                     self.clear_nail_branch(&at, nail, (&back, &pose), &nail_tcp)
                         .map(|qa| (qa, s))
                 });
-            blocked_at = None;
+            blocked = false;
             match attempt {
                 Ok((_, s)) if from.is_some() && (s - self.cell.carriage()).abs() < 1e-9 => {
                     // Abeam leads back to where the carriage stands: blocked as before.
@@ -291,24 +291,20 @@ impl<'a> WallRun<'a> {
                     let begun = *start.get_or_insert_with(|| {
                         self.begin(&nail.plate, "nail", &[nail.member.as_str()])
                     });
-                    let mut way = self
-                        .move_carriage(s, &nail_tcp, &[])
-                        .and_then(|()| self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed()));
+                    let mut way = self.move_to_approach(s, &q_back, &nail_tcp);
                     if way.is_err() && !lifted {
                         // Blocked from a tight spot (the nose down among the pieces after
                         // the last nail): once per nail, lift straight out and try again.
                         lifted = true;
                         if self.lift_out(&nail_tcp).is_ok() {
-                            way = self.move_carriage(s, &nail_tcp, &[]).and_then(|()| {
-                                self.move_to(&q_back, &nail_tcp, &[], self.nailing_speed())
-                            });
+                            way = self.move_to_approach(s, &q_back, &nail_tcp);
                         }
                     }
                     if let Err(f) = way {
                         // Reachable and clear, only the way there is blocked: the most
                         // telling miss.
                         miss = Some((-2.0, f));
-                        blocked_at = Some(s);
+                        blocked = true;
                         path_tries += 1;
                         if path_tries == MAX_PATH_TRIES {
                             break;
@@ -334,6 +330,17 @@ impl<'a> WallRun<'a> {
             }
         }
         Err((start, miss.map_or(IkFailure::InvalidPose, |m| m.1)))
+    }
+
+    /// The carriage to `s` and the arm to a nail's approach joints `q_back`.
+    fn move_to_approach(
+        &mut self,
+        s: f64,
+        q_back: &[f64],
+        tcp: &Isometry3<f64>,
+    ) -> Result<(), IkFailure> {
+        self.move_carriage(s, tcp, &[])?;
+        self.move_to(q_back, tcp, &[], self.nailing_speed())
     }
 
     /// Lifts the tool straight up by LIFT_OUT from where it is, at the nailer's approach speed.
