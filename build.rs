@@ -1,7 +1,10 @@
-//! Compiles the built-in rule base (all `rules/*.dl` as one program, entry
-//! `"rules"`), each `tests/logic/*.dl` and `benches/logic/*.dl`, and every program of the
-//! Soufflé corpus `tests/fixtures/souffle/*.dl` that the generator accepts into ascent programs in `OUT_DIR/logic_compiled.rs`,
-//! using the same parser and checker as the interpreter.
+//! Compiles the built-in rule base (all `rules/*.dl` as one program, entry `"rules"`) into
+//! ascent programs in `OUT_DIR/logic_compiled.rs`, using the same parser and checker as the
+//! interpreter. With the feature `logic-test-programs` (on for the crate's own tests and
+//! benches only, through its dev-dependency on itself) it also compiles each
+//! `tests/logic/*.dl` and `benches/logic/*.dl` and every program of the Soufflé corpus
+//! `tests/fixtures/souffle/*.dl` that the generator accepts: the binary users install does
+//! not carry them.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -79,9 +82,12 @@ fn main() {
     println!("cargo:rerun-if-changed=src/logic/front");
     println!("cargo:rerun-if-changed=src/logic/functor_defs.rs");
     println!("cargo:rerun-if-changed=src/frame/rule_reads.rs");
+    let test_programs = std::env::var_os("CARGO_FEATURE_LOGIC_TEST_PROGRAMS").is_some();
+    let test_dirs = ["tests/logic", "benches/logic", SOUFFLE_CORPUS];
     let mut out = String::new();
     let mut table = Vec::new();
-    for dir in ["rules", "tests/logic", "benches/logic", SOUFFLE_CORPUS] {
+    let watched = if test_programs { &test_dirs[..] } else { &[] };
+    for dir in std::iter::once("rules").chain(watched.iter().copied()) {
         println!("cargo:rerun-if-changed={dir}");
         // Included fragments live in subdirectories; watch them too.
         if let Ok(rd) = std::fs::read_dir(root.join(dir)) {
@@ -115,7 +121,26 @@ fn main() {
         out.push_str(&placed_slice(&program, "builtin_rules", "builtin_placed"));
         out.push_str(&plan_scope(&program));
     }
-    // Test and benchmark programs: one program per file.
+    if test_programs {
+        test_and_bench_programs(&root, &mut out, &mut table);
+    }
+    let _ = writeln!(
+        out,
+        "/// Every compiled program: (path, entry point).\npub static PROGRAMS: &[(&str, RunFn)] = &["
+    );
+    for (rel, module) in &table {
+        let _ = writeln!(out, "    ({rel:?}, {module}::run),");
+    }
+    out.push_str("];\n");
+    let dest = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
+        .join("logic_compiled.rs");
+    std::fs::write(&dest, out).expect("write generated rules");
+}
+
+/// The test and benchmark programs (one program per file) and every program of the Soufflé
+/// corpus the code generator accepts (tests/souffle_corpus.rs checks which ones it refuses,
+/// and why), appended to `out` and listed in `table`.
+fn test_and_bench_programs(root: &Path, out: &mut String, table: &mut Vec<(String, String)>) {
     for dir in ["tests/logic", "benches/logic"] {
         for file in dl_files(&root.join(dir)) {
             let rel = format!("{dir}/{}", file.file_name().unwrap().to_string_lossy());
@@ -131,8 +156,6 @@ fn main() {
             table.push((rel, module));
         }
     }
-    // The Soufflé compatibility corpus: every program the code generator
-    // accepts (tests/souffle_corpus.rs checks which ones it refuses, and why).
     for file in dl_files(&root.join(SOUFFLE_CORPUS)) {
         let rel = format!(
             "{SOUFFLE_CORPUS}/{}",
@@ -147,17 +170,6 @@ fn main() {
             table.push((rel, module));
         }
     }
-    let _ = writeln!(
-        out,
-        "/// Every compiled program: (path, entry point).\npub static PROGRAMS: &[(&str, RunFn)] = &["
-    );
-    for (rel, module) in &table {
-        let _ = writeln!(out, "    ({rel:?}, {module}::run),");
-    }
-    out.push_str("];\n");
-    let dest = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
-        .join("logic_compiled.rs");
-    std::fs::write(&dest, out).expect("write generated rules");
 }
 
 /// The rule base cut down to what `plan` asks of it (`rule_reads`): every rule of a relation

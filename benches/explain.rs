@@ -14,11 +14,11 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use framewright::cell::Cell;
+use framewright::explain::why::{Context, why};
 use framewright::frame::plan::Plan;
 use framewright::frame::{Facts, RuleEngine, cell_facts, model_facts, reason};
 use framewright::ifc::Model;
 use framewright::user_rules::UserRules;
-use framewright::user_rules::why::{Context, why};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 

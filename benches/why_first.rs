@@ -1,17 +1,18 @@
 //! The simulation behind a first `why` on an element of the 4,020-member model
 //! (`../shared/ifc-testcases/g_scale_3storey.ifc`, skipped when absent): the element's wall
 //! simulated as `why` did before (the whole model planned, the run reasoned over afterwards:
-//! `simulate(..).facts`) and as it does now (`simulate_wall_facts`: the wall's storey alone,
+//! `simulate(..).facts`) and as it does now (`cache::wall_facts_cached`: the wall's storey alone,
 //! no reasoning afterwards), in the same run, with the ratio. Both must give the same facts.
 //!
 //! `cargo bench --bench why_first [-- ID]` (default `#20002`, a jack stud of a 228-piece wall).
 
+use framewright::cache::wall_facts_cached;
 use framewright::cell::Cell;
+use framewright::explain::why::{Context, element_walls};
 use framewright::frame::{RuleEngine, cell_facts, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
-use framewright::sim::{SimOptions, simulate, simulate_wall_facts};
-use framewright::user_rules::why::{Context, element_walls};
+use framewright::sim::{SimOptions, simulate};
 use std::path::Path;
 use std::time::Instant;
 
@@ -48,7 +49,9 @@ fn main() {
         .facts;
     let whole = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    let now = simulate_wall_facts(&model, &cell, &options).expect("one-storey run");
+    let now = wall_facts_cached(&model, &cell, &options, None)
+        .map(|(facts, _)| facts)
+        .expect("one-storey run");
     let alone = start.elapsed().as_secs_f64();
     assert_eq!(format!("{now:?}"), format!("{before:?}"), "same facts");
     println!(

@@ -10,6 +10,7 @@ pub mod bim;
 pub mod cache;
 pub mod cell;
 pub mod diff;
+pub mod explain;
 pub mod frame;
 pub mod geom;
 pub mod ifc;

@@ -1,14 +1,15 @@
-//! `simulate_wall_facts` (what `why` simulates for one element's wall) plans the wall from its
+//! `cache::wall_facts_cached` (what `why` simulates for one element's wall) plans the wall from its
 //! storey's facts alone; its facts must be the ones a simulation of the whole model gives
 //! for that wall.
 
 mod common;
 
+use framewright::cache::wall_facts_cached;
 use framewright::cell::Cell;
 use framewright::frame::{cell_facts, model_facts, reason};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
-use framewright::sim::{SimOptions, simulate, simulate_wall_facts};
+use framewright::sim::{SimOptions, simulate};
 use std::path::Path;
 
 /// A generated block of two storeys (two spatial containers), walls grouped in IfcWall.
@@ -83,7 +84,9 @@ fn one_wall_from_its_storey_gives_the_facts_of_a_whole_model_run() {
     let whole = simulate(&model, &cell, &options)
         .expect("whole-model run")
         .facts;
-    let alone = simulate_wall_facts(&model, &cell, &options).expect("one-wall run");
+    let alone = wall_facts_cached(&model, &cell, &options, None)
+        .map(|(facts, _)| facts)
+        .expect("one-wall run");
     assert!(
         whole
             .tuples
@@ -108,6 +111,6 @@ fn an_unknown_wall_is_an_error_naming_it() {
         ..SimOptions::default()
     };
     let err =
-        simulate_wall_facts(&model, &cell, &options).expect_err("an unknown wall is an error");
+        wall_facts_cached(&model, &cell, &options, None).expect_err("an unknown wall is an error");
     assert!(err.to_string().contains("no such wall"), "{err}");
 }

@@ -569,3 +569,78 @@ fn why_answers_first_on_a_real_wall() {
         "no nail's tree: {text}"
     );
 }
+
+/// TM3's top plate #174 (wall F) and a stud of another wall (L-008), as the model places them.
+const TOP_PLATE_AT: &str = "#167=IFCCARTESIANPOINT((6.858,0.04445,2.409825));";
+const TOP_PLATE_RAISED: &str = "#167=IFCCARTESIANPOINT((6.858,0.04445,2.411825));";
+const OTHER_STUD_AT: &str = "#234=IFCCARTESIANPOINT((0.04445,2.32537,0.0381));";
+const OTHER_STUD_MOVED: &str = "#234=IFCCARTESIANPOINT((0.04445,2.30537,0.0381));";
+
+#[test]
+fn why_and_simulate_share_one_cache_entry_per_wall() {
+    // One cache, one key: the wall `simulate` stored is the wall `why` reads, an edit to
+    // another wall leaves it, and an edit to the element's wall simulates it again, with
+    // another answer.
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let cache = cache.to_str().unwrap();
+    let text = std::fs::read_to_string(tm3()).unwrap();
+    assert!(
+        text.contains(TOP_PLATE_AT) && text.contains(OTHER_STUD_AT),
+        "tm3.ifc changed; pick the points again"
+    );
+    let write = |name: &str, text: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let model = write("tm3.ifc", &text);
+    let model = model.to_str().unwrap();
+    ok(&["simulate", "--offset-x", "0.531", model, "--cache", cache]);
+    let why = |model: &str| {
+        ok(&[
+            "why",
+            "--offset-x",
+            "0.531",
+            model,
+            "#174",
+            "--cache",
+            cache,
+        ])
+    };
+    let answer = why(model);
+    let from_cache = format!("simulated {} (from the cache)\n", top_plate_wall());
+    assert!(answer.starts_with(&from_cache), "{answer}");
+    let fresh = ok(&["why", "--offset-x", "0.531", model, "#174", "--no-cache"]);
+    assert_eq!(
+        answer.lines().skip(1).collect::<Vec<_>>(),
+        fresh.lines().skip(1).collect::<Vec<_>>(),
+        "the entry `simulate` stored answers as a fresh simulation does"
+    );
+
+    let other = write("other.ifc", &text.replace(OTHER_STUD_AT, OTHER_STUD_MOVED));
+    let other_answer = why(other.to_str().unwrap());
+    assert!(
+        other_answer.starts_with(&from_cache),
+        "an edit to another wall keeps this wall's entry: {other_answer}"
+    );
+    assert_eq!(other_answer, answer);
+
+    let raised = write("raised.ifc", &text.replace(TOP_PLATE_AT, TOP_PLATE_RAISED));
+    let raised_answer = why(raised.to_str().unwrap());
+    assert!(
+        raised_answer.starts_with(&format!("simulated {}\n", top_plate_wall())),
+        "the element's own wall edited is simulated again: {raised_answer}"
+    );
+    // The plate is the wall's far edge from the arm: 2 mm higher in the model, its place
+    // pose lies about 2 mm farther out of reach.
+    let too_far = |text: &str| -> i64 {
+        let (head, _) = text.split_once(" mm too far)").expect(text);
+        head.rsplit_once('(').unwrap().1.parse().unwrap()
+    };
+    let farther = too_far(&raised_answer) - too_far(&answer);
+    assert!(
+        (1..=3).contains(&farther),
+        "{farther} mm: {answer}\n{raised_answer}"
+    );
+}

@@ -3,15 +3,16 @@
 //! verdict rule down to the executor's fact, the IFC entities and the cell keys. The numbers
 //! in it are checked against the arm's own kinematic chain and the plate's place.
 
+use framewright::cache::wall_facts_cached;
 use framewright::cell::Cell;
+use framewright::explain::render::render_why;
+use framewright::explain::why::{Context, WhyReport, why};
 use framewright::frame::{Facts, RuleEngine, cell_facts, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::logic::provenance::{How, Premise};
 use framewright::logic::{Explanation, Origin, Value};
-use framewright::sim::{SimOptions, simulate_wall_facts};
-use framewright::user_rules::render::render_why;
-use framewright::user_rules::why::{Context, WhyReport, why};
+use framewright::sim::SimOptions;
 use nalgebra::Vector3;
 use std::path::Path;
 
@@ -43,7 +44,11 @@ fn facts(model: &Model, sim: bool) -> Facts {
             walls: vec!["W1".to_string()],
             ..SimOptions::default()
         };
-        facts.extend(simulate_wall_facts(model, &cell, &options).expect("W1 simulates"));
+        facts.extend(
+            wall_facts_cached(model, &cell, &options, None)
+                .map(|(facts, _)| facts)
+                .expect("W1 simulates"),
+        );
     }
     facts
 }

@@ -19,21 +19,16 @@
 //! one with fresh ids, and FILE_NAME's preprocessor field names the tool. GlobalIds are
 //! derived from the elements' GlobalIds, so the same inputs give the same bytes.
 
+use super::entities::{PSET_NAME, guid_for, label, property, swept_body, typed};
 use super::error::AnnotateError;
 use super::step_edit::{Appender, file_name_span, insertion_point, splice};
+use super::verdicts::ElementVerdict;
 use crate::frame::plan::{Plan, Wall};
 use crate::ifc::{Model, Piece, Schema};
 use crate::step::StepFile;
-use crate::synth::guid;
 use crate::synth::step_text::{Real, RealList, Ref, RefList, string};
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
-
-/// Name of the property set written on every element.
-pub const PSET_NAME: &str = "Framewright_Assembly";
-
-/// Seed of the GlobalIds of everything `annotate` writes.
-const GUID_SEED: u64 = 0x6672_616d_6577_7269;
 
 /// Size of the nails written as fasteners, metres.
 #[derive(Debug, Clone, Copy)]
@@ -50,17 +45,6 @@ impl Default for NailSize {
             diameter: 0.0033,
         }
     }
-}
-
-/// What the simulation says about one piece.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ElementVerdict {
-    pub framing: String,
-    pub nailing: String,
-    /// The first reason, one line; empty when the piece passed.
-    pub reason: String,
-    /// Smallest reach margin over the piece's solved poses, metres.
-    pub reach_margin: Option<f64>,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -83,31 +67,6 @@ pub struct Annotated {
     /// Panels written as `IfcElementAssembly`, and the members added to them.
     pub panels: super::panels::PanelsWritten,
     pub first_new_id: u64,
-}
-
-/// IfcLabel and IfcIdentifier hold at most 255 characters.
-fn short(text: &str) -> &str {
-    text.char_indices()
-        .nth(255)
-        .map_or(text, |(at, _)| &text[..at])
-}
-
-/// A label attribute (names): at most 255 characters.
-pub(super) fn label(text: &str) -> String {
-    string(short(text))
-}
-
-/// `IFCLABEL('…')` and friends.
-pub(super) fn typed(kind: &str, text: &str) -> String {
-    let text = if kind == "IFCTEXT" { text } else { short(text) };
-    format!("{kind}({})", string(text))
-}
-
-pub(super) fn guid_for(kind: &str, key: &str) -> String {
-    string(&guid::global_id(
-        GUID_SEED,
-        &format!("framewright/annotate/{kind}/{key}"),
-    ))
 }
 
 fn opt_text(text: &str) -> String {
@@ -162,40 +121,6 @@ fn products(model: &Model) -> Vec<(u64, Vec<&Piece>)> {
         }
     }
     order
-}
-
-/// A body: `profile` swept `depth` (model units) along its placement's z axis, in the body
-/// representation context `context`.
-pub(super) fn swept_body(w: &mut Appender, context: u64, profile: Ref, depth: f64) -> Ref {
-    let up = w.add("IFCDIRECTION", "(0.,0.,1.)");
-    let solid = w.add(
-        "IFCEXTRUDEDAREASOLID",
-        format!("{profile},$,{up},{}", Real(depth)),
-    );
-    let rep = w.add(
-        "IFCSHAPEREPRESENTATION",
-        format!(
-            "#{context},{},{},({solid})",
-            string("Body"),
-            string("SweptSolid")
-        ),
-    );
-    w.add("IFCPRODUCTDEFINITIONSHAPE", format!("$,$,({rep})"))
-}
-
-/// One property: a single value for a one-piece product, a list (one value per piece) otherwise.
-pub(super) fn property(w: &mut Appender, name: &str, values: &[String]) -> Ref {
-    if let [value] = values {
-        w.add(
-            "IFCPROPERTYSINGLEVALUE",
-            format!("{},$,{value},$", string(name)),
-        )
-    } else {
-        w.add(
-            "IFCPROPERTYLISTVALUE",
-            format!("{},$,({}),$", string(name), values.join(",")),
-        )
-    }
 }
 
 /// Everything the writer needs to know about the plan, by piece id.

@@ -11,14 +11,14 @@
 
 pub mod annotate;
 pub mod bcf;
+mod entities;
 mod error;
 mod panels;
 pub mod step_edit;
 mod verdicts;
 
-pub use annotate::{
-    AnnotateOptions, Annotated, ElementVerdict, NailSize, PSET_NAME, annotate, iso_date_time,
-};
+pub use annotate::{AnnotateOptions, Annotated, NailSize, annotate, iso_date_time};
 pub use bcf::{BcfHeader, BcfVersion};
+pub use entities::PSET_NAME;
 pub use error::AnnotateError;
-pub use verdicts::element_verdicts;
+pub use verdicts::{ElementVerdict, element_verdicts};

@@ -13,8 +13,9 @@
 //!   stretch of a lapped cap plate across a joint: a new `IfcMember` in no panel, `Panel` =
 //!   `site`).
 
-use super::annotate::{ElementVerdict, PSET_NAME, guid_for, label, property, swept_body, typed};
+use super::entities::{PSET_NAME, guid_for, label, property, swept_body, typed};
 use super::step_edit::Appender;
+use super::verdicts::ElementVerdict;
 use crate::frame::panelize::{moved_box, segment_box};
 use crate::frame::plan::Plan;
 use crate::geom::OrientedBox;

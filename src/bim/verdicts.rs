@@ -1,10 +1,20 @@
 //! The per-piece verdicts of a simulation, in the shape the BIM writers need them:
 //! framing and nailing status, the first reason (one line), the tightest reach margin.
 
-use super::annotate::ElementVerdict;
 use crate::logic::Value;
 use crate::sim::Simulation;
 use std::collections::BTreeMap;
+
+/// What the simulation says about one piece.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ElementVerdict {
+    pub framing: String,
+    pub nailing: String,
+    /// The first reason, one line; empty when the piece passed.
+    pub reason: String,
+    /// Smallest reach margin over the piece's solved poses, metres.
+    pub reach_margin: Option<f64>,
+}
 
 fn sym(v: &Value) -> String {
     v.as_symbol().unwrap_or_default().to_string()

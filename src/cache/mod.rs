@@ -15,12 +15,6 @@ pub use plan::{reason_plan_cached, reason_plan_cached_with};
 pub use plan_writer::PlanWriter;
 pub use sim::{
     CacheCounts, Need, Shard, ShardRun, cached_simulation, simulate_cached, simulate_cached_for,
-    simulate_shard,
+    simulate_shard, wall_facts_cached,
 };
 pub use store::{Cache, CacheInfo, clear, info};
-
-/// The default cache folder: `$FRAMEWRIGHT_CACHE`, else `$XDG_CACHE_HOME/framewright`, else
-/// `$HOME/.cache/framewright` (None when none is set).
-pub fn default_dir() -> Option<std::path::PathBuf> {
-    crate::user_rules::sim_cache::default_cache_dir()
-}

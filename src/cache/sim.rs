@@ -5,10 +5,11 @@
 use super::key::{build_id, wall_key};
 use super::store::{Cache, Lookup};
 use crate::cell::Cell;
+use crate::frame::Facts;
 use crate::ifc::Model;
 use crate::sim::{
-    Prepared, SimError, SimOptions, Simulation, WallRecord, check_options, prepare, run_prepared,
-    select_walls,
+    Prepared, SimError, SimOptions, Simulation, WallRecord, check_options, prepare,
+    prepare_named_walls, records_facts, run_prepared, select_walls,
 };
 use serde::Serialize;
 
@@ -83,6 +84,11 @@ fn prepare_keyed(
 ) -> Result<Keyed, SimError> {
     check_options(options)?;
     let prepared = prepare(model, model_name, cell, &options.engine)?;
+    key_walls(prepared, cell, options)
+}
+
+/// The cache keys of the walls `options.walls` selects of a prepared run.
+fn key_walls(prepared: Prepared, cell: &Cell, options: &SimOptions) -> Result<Keyed, SimError> {
     let (scene, plan) = (&prepared.scene, &prepared.plan);
     let build = build_id();
     let mut walls = Vec::new();
@@ -151,14 +157,61 @@ pub fn simulate_cached_for(
         &keyed.prepared,
         cell,
         options,
-        cache,
+        Some(cache),
         &misses,
         need,
         progress,
     )?;
     counts.computed = computed.len();
+    let records = in_wall_order(found, &mut computed, &keyed.walls)?;
+    let sim = Simulation::from_prepared(keyed.prepared, records, &options.engine)?;
+    Ok((sim, counts))
+}
+
+/// The `rules/sim.dl` facts of the walls `options.walls` names (`why` explains an element
+/// from its wall's), each wall's record read from the cache under the key `simulate` gives
+/// it, else simulated and stored: one cache, one key, so `why` after `simulate` (or the
+/// other way round) simulates nothing again, and whatever misses `simulate`'s entry misses
+/// this one. The walls are planned from their containers alone (`sim::prepare_named_walls`).
+pub fn wall_facts_cached(
+    model: &Model,
+    cell: &Cell,
+    options: &SimOptions,
+    cache: Option<&Cache>,
+) -> Result<(Facts, CacheCounts), SimError> {
+    let prepared = prepare_named_walls(model, cell, options)?;
+    let keyed = key_walls(prepared, cell, options)?;
+    let (found, misses, mut counts) = match cache {
+        Some(cache) => look_up(cache, &keyed.walls, Need::Records),
+        None => (
+            keyed.walls.iter().map(|_| None).collect(),
+            keyed.walls.clone(),
+            CacheCounts::default(),
+        ),
+    };
+    let mut computed = simulate_misses(
+        &keyed.prepared,
+        cell,
+        options,
+        cache,
+        &misses,
+        Need::Records,
+        &|_, _, _| {},
+    )?;
+    counts.computed = computed.len();
+    let records = in_wall_order(found, &mut computed, &keyed.walls)?;
+    Ok((records_facts(&records), counts))
+}
+
+/// The walls' records in their order: the cached ones `found`, the others taken from
+/// `computed`.
+fn in_wall_order(
+    found: Vec<Option<WallRecord>>,
+    computed: &mut Vec<WallRecord>,
+    walls: &[(String, String)],
+) -> Result<Vec<WallRecord>, SimError> {
     let mut records = Vec::with_capacity(found.len());
-    for (record, (key_piece, _)) in found.into_iter().zip(&keyed.walls) {
+    for (record, (key_piece, _)) in found.into_iter().zip(walls) {
         match record {
             Some(r) => records.push(r),
             None => {
@@ -170,8 +223,7 @@ pub fn simulate_cached_for(
             }
         }
     }
-    let sim = Simulation::from_prepared(keyed.prepared, records, &options.engine)?;
-    Ok((sim, counts))
+    Ok(records)
 }
 
 /// The simulation of the model when the cache holds every selected wall; None otherwise
@@ -215,7 +267,7 @@ pub fn simulate_shard(
         &keyed.prepared,
         cell,
         options,
-        cache,
+        Some(cache),
         &misses,
         Need::Records,
         progress,
@@ -285,7 +337,7 @@ fn simulate_misses(
     prepared: &Prepared,
     cell: &Cell,
     options: &SimOptions,
-    cache: &Cache,
+    cache: Option<&Cache>,
     misses: &[(String, String)],
     need: Need,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
@@ -295,9 +347,11 @@ fn simulate_misses(
     }
     let keys: Vec<String> = misses.iter().map(|(k, _)| k.clone()).collect();
     let records = run_prepared(prepared, cell, options, &keys, progress)?;
-    for r in &records {
-        if let Some((_, key)) = misses.iter().find(|(k, _)| k == &r.wall) {
-            store(cache, key, r, need);
+    if let Some(cache) = cache {
+        for r in &records {
+            if let Some((_, key)) = misses.iter().find(|(k, _)| k == &r.wall) {
+                store(cache, key, r, need);
+            }
         }
     }
     Ok(records)

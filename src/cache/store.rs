@@ -17,7 +17,8 @@ use std::thread::JoinHandle;
 const WALLS: &str = "walls";
 /// Subfolder of `plan`'s part entries.
 const PLANS: &str = "plans";
-/// Entries of `why`'s single-wall cache, kept at the top of the folder.
+/// Entries of the single-wall cache `why` kept before it shared the wall entries (still
+/// counted and cleared).
 const WHY_PREFIX: &str = "sim-";
 
 /// A cache folder in use.

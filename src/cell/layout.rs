@@ -522,15 +522,6 @@ impl Cell {
         }
     }
 
-    /// The carriage positions to try for a target at `point` (cell frame), nearest `from`
-    /// first; the current position alone without a track.
-    pub fn carriage_positions(&self, from: f64) -> Vec<f64> {
-        match &self.track {
-            Some(t) => t.positions_from(from),
-            None => vec![self.carriage()],
-        }
-    }
-
     /// A cell-frame pose in the robot's base_link frame.
     pub fn to_robot(&self, pose: &Isometry3<f64>) -> Isometry3<f64> {
         self.robot_base.inverse() * pose
@@ -921,7 +912,7 @@ fn base_clearance(robot: &Robot) -> f64 {
         .links
         .iter()
         .enumerate()
-        .filter(|(i, _)| super::tcp_poses::moving_joints_above(robot, *i) <= 1)
+        .filter(|(i, _)| robot.moving_joints_above(*i) <= 1)
         .flat_map(|(i, link)| link.collisions.iter().map(move |c| (i, c)))
         .map(|(i, c)| {
             let centre = (poses[i] * c.origin).translation.vector;

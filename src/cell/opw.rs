@@ -2,12 +2,9 @@
 //! wrist (OPW: Brandstötter, Angerer & Hofbaur, 2014). Written for this project from the paper's
 //! equations; the parameters are checked against the URDF chain when a robot is loaded.
 
-use super::error::CellError;
 use super::meta::OpwParams;
-use super::robot::{JointKind, Robot};
 use nalgebra::{Isometry3, Vector3};
 use std::f64::consts::PI;
-use std::path::Path;
 
 #[derive(Debug, Clone)]
 pub(crate) struct Opw {
@@ -27,51 +24,10 @@ pub(crate) struct OpwResult {
 }
 
 impl Opw {
-    /// Checks the parameters against the URDF's FK on a fixed set of joint vectors.
-    pub fn new(path: &Path, robot: &Robot, p: OpwParams) -> Result<Opw, CellError> {
-        if robot.dof() != 6 {
-            return Err(CellError::urdf(
-                path,
-                format!(
-                    "OPW parameters given for a robot with {} moving joints (need 6)",
-                    robot.dof()
-                ),
-            ));
-        }
-        if let Some(j) = robot
-            .active_joints()
-            .find(|j| !matches!(j.kind, JointKind::Revolute | JointKind::Continuous))
-        {
-            return Err(CellError::urdf(
-                path,
-                format!(
-                    "OPW parameters need six revolute joints; `{}` is not revolute",
-                    j.name
-                ),
-            ));
-        }
-        let opw = Opw { p };
-        let probes: [[f64; 6]; 4] = [
-            [0.0; 6],
-            [0.3, -0.4, 0.5, 0.7, -0.9, 1.1],
-            [-1.2, 0.2, -0.3, -2.0, 1.0, -0.5],
-            [2.0, -0.1, 0.9, 1.5, 0.4, 2.5],
-        ];
-        for q in probes {
-            let urdf = robot.fk_tip_unmounted(&q);
-            let own = opw.forward(&q);
-            let dp = (urdf.translation.vector - own.translation.vector).norm();
-            let dr = urdf.rotation.angle_to(&own.rotation);
-            if dp > 1e-9 || dr > 1e-9 {
-                return Err(CellError::urdf(
-                    path,
-                    format!(
-                        "the OPW parameters do not match the URDF chain (at q = {q:?} the tip differs by {dp:.3e} m, {dr:.3e} rad); fix [opw] in the robot's metadata or remove it to use the numeric IK"
-                    ),
-                ));
-            }
-        }
-        Ok(opw)
+    /// The solver of parameters `p` (the robot checks them against its URDF chain when it
+    /// loads: `Robot::checked_opw`).
+    pub fn new(p: OpwParams) -> Opw {
+        Opw { p }
     }
 
     /// Reach of the wrist centre from the shoulder: (min, max), m.

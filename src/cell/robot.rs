@@ -2,7 +2,7 @@
 //! `base_link` to the tip (usually `tool0`), and forward kinematics on nalgebra.
 
 use super::error::CellError;
-use super::meta::RobotMeta;
+use super::meta::{OpwParams, RobotMeta};
 use super::opw::Opw;
 use super::shapes::{PlacedShape, Shape, isometry_from_xyz_rpy};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
@@ -116,6 +116,17 @@ pub struct Robot {
 }
 
 impl Robot {
+    /// How many moving joints lie between a link and the robot's root (0 for the base, 1 for
+    /// the turntable on it).
+    pub fn moving_joints_above(&self, mut link: usize) -> usize {
+        let mut n = 0;
+        while let Some(j) = self.links[link].parent_joint {
+            n += usize::from(self.joints[j].dof_index.is_some());
+            link = self.joints[j].parent;
+        }
+        n
+    }
+
     /// Build a robot from URDF text and its metadata. `path` is used in messages only.
     pub fn from_urdf_str(path: &Path, urdf: &str, meta: RobotMeta) -> Result<Robot, CellError> {
         if let Some(line) = super::urdf_depth::too_deep(urdf) {
@@ -133,9 +144,57 @@ impl Robot {
         let mut robot = build_tree(path, &parsed, &meta)?;
         robot.meta = meta;
         if let Some(params) = robot.meta.opw {
-            robot.opw = Some(Opw::new(path, &robot, params)?);
+            robot.opw = Some(robot.checked_opw(path, params)?);
         }
         Ok(robot)
+    }
+
+    /// The closed-form solver of OPW parameters `p`, checked against the URDF's FK on a fixed
+    /// set of joint vectors.
+    fn checked_opw(&self, path: &Path, p: OpwParams) -> Result<Opw, CellError> {
+        if self.dof() != 6 {
+            return Err(CellError::urdf(
+                path,
+                format!(
+                    "OPW parameters given for a robot with {} moving joints (need 6)",
+                    self.dof()
+                ),
+            ));
+        }
+        if let Some(j) = self
+            .active_joints()
+            .find(|j| !matches!(j.kind, JointKind::Revolute | JointKind::Continuous))
+        {
+            return Err(CellError::urdf(
+                path,
+                format!(
+                    "OPW parameters need six revolute joints; `{}` is not revolute",
+                    j.name
+                ),
+            ));
+        }
+        let opw = Opw::new(p);
+        let probes: [[f64; 6]; 4] = [
+            [0.0; 6],
+            [0.3, -0.4, 0.5, 0.7, -0.9, 1.1],
+            [-1.2, 0.2, -0.3, -2.0, 1.0, -0.5],
+            [2.0, -0.1, 0.9, 1.5, 0.4, 2.5],
+        ];
+        for q in probes {
+            let urdf = self.fk_tip_unmounted(&q);
+            let own = opw.forward(&q);
+            let dp = (urdf.translation.vector - own.translation.vector).norm();
+            let dr = urdf.rotation.angle_to(&own.rotation);
+            if dp > 1e-9 || dr > 1e-9 {
+                return Err(CellError::urdf(
+                    path,
+                    format!(
+                        "the OPW parameters do not match the URDF chain (at q = {q:?} the tip differs by {dp:.3e} m, {dr:.3e} rad); fix [opw] in the robot's metadata or remove it to use the numeric IK"
+                    ),
+                ));
+            }
+        }
+        Ok(opw)
     }
 
     /// Number of moving joints.

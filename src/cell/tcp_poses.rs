@@ -2,7 +2,6 @@
 //! centre of mass, the nailer on a nail line, and how low the arm and its tool reach.
 
 use super::layout::Cell;
-use super::robot::Robot;
 use super::shapes::{PlacedShape, Shape};
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
@@ -109,7 +108,7 @@ pub fn lowest_point(cell: &Cell, q: &[f64]) -> f64 {
         .links
         .iter()
         .enumerate()
-        .filter(|(i, _)| moving_joints_above(robot, *i) > 1)
+        .filter(|(i, _)| robot.moving_joints_above(*i) > 1)
         .flat_map(|(i, link)| {
             link.collisions
                 .iter()
@@ -118,17 +117,6 @@ pub fn lowest_point(cell: &Cell, q: &[f64]) -> f64 {
     let tool = cell.robot_base * poses[robot.tip];
     let parts = cell.tool.parts.iter().map(|p| lowest(&tool, &p.shape));
     links.chain(parts).fold(f64::INFINITY, f64::min)
-}
-
-/// How many moving joints lie between a link and the robot's root (0 for the base, 1 for the
-/// turntable on it).
-pub fn moving_joints_above(robot: &Robot, mut link: usize) -> usize {
-    let mut n = 0;
-    while let Some(j) = robot.links[link].parent_joint {
-        n += usize::from(robot.joints[j].dof_index.is_some());
-        link = robot.joints[j].parent;
-    }
-    n
 }
 
 /// The lowest z of a placed shape whose owner is at `owner`.

@@ -5,6 +5,19 @@ use super::{CmdResult, Failure, print_stdout};
 use framewright::cache::{self, Cache};
 use std::path::PathBuf;
 
+/// The default cache folder: `$FRAMEWRIGHT_CACHE`, else `$XDG_CACHE_HOME/framewright`, else
+/// `$HOME/.cache/framewright` (None when none is set).
+pub fn default_dir() -> Option<PathBuf> {
+    let var = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    var("FRAMEWRIGHT_CACHE")
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("framewright")))
+        .or_else(|| var("HOME").map(|d| d.join(".cache/framewright")))
+}
+
 /// Where results are cached.
 #[derive(clap::Args, Clone, Debug)]
 pub struct CacheArgs {
@@ -23,7 +36,7 @@ impl CacheArgs {
         if self.no_cache {
             return None;
         }
-        let dir = self.cache.clone().or_else(cache::default_dir);
+        let dir = self.cache.clone().or_else(default_dir);
         if dir.is_none() {
             eprintln!(
                 "warning: no cache folder (set FRAMEWRIGHT_CACHE or HOME, or give --cache DIR); \
@@ -34,12 +47,9 @@ impl CacheArgs {
     }
 
     fn dir(&self) -> Result<PathBuf, Failure> {
-        self.cache
-            .clone()
-            .or_else(cache::default_dir)
-            .ok_or_else(|| {
-                Failure::bad_input("no cache folder: give --cache DIR or set FRAMEWRIGHT_CACHE")
-            })
+        self.cache.clone().or_else(default_dir).ok_or_else(|| {
+            Failure::bad_input("no cache folder: give --cache DIR or set FRAMEWRIGHT_CACHE")
+        })
     }
 }
 

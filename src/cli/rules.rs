@@ -1,6 +1,6 @@
 //! `framewright rules run|check`: run a rule program like
 //! `souffle -F FACTS -D OUT PROG.dl`, or only check it.
-use super::{CmdResult, Failure, print_stdout};
+use super::{CmdResult, print_stdout};
 use framewright::logic::{Engine, Limits, Options, Program, io, provenance};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -115,6 +115,3 @@ pub fn run(cmd: RulesCommand) -> CmdResult {
         }
     }
 }
-
-#[allow(dead_code)]
-fn _failure_type(_: Failure) {}

@@ -5,19 +5,21 @@
 
 use super::check::{ReasoningInputs, load_inputs, load_model_facts, rules_in_force};
 use super::{CmdResult, Failure, print_stdout};
+use framewright::cache::{Cache, wall_facts_cached};
+use framewright::explain::render::{render_answer, render_why, render_why_not};
+use framewright::explain::why::{
+    Context, WhyError, element_walls_split, name_walls, resolve_element, why, why_not,
+};
 use framewright::frame::RuleLimits;
 use framewright::frame::containers::{containers_of, restrict_to_containers};
+use framewright::frame::panel::PanelOf;
 use framewright::frame::panel_why;
-use framewright::frame::panelize::{PanelOf, panels_by_piece};
+use framewright::frame::panelize::panels_by_piece;
 use framewright::frame::placement::{add_placement_facts, reason_placed};
 use framewright::frame::plan::Plan;
 use framewright::logic::compiled::Relations;
+use framewright::sim::SimOptions;
 use framewright::sim::{prepare_facts, whole_facts};
-use framewright::user_rules::render::{render_answer, render_why, render_why_not};
-use framewright::user_rules::sim_cache::{default_cache_dir, wall_sim_facts};
-use framewright::user_rules::why::{
-    Context, WhyError, element_walls_split, name_walls, resolve_element, why, why_not,
-};
 use serde::Serialize;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -84,7 +86,6 @@ struct Simulated {
 /// containers), and the model is returned, for the explanation to name its pieces.
 fn simulate_walls(
     c: &Common,
-    model_path: &std::path::Path,
     model: &framewright::ifc::Model,
     cell: &framewright::cell::Cell,
     facts: &mut framewright::frame::Facts,
@@ -130,17 +131,24 @@ fn simulate_walls(
     let cache = if c.no_cache {
         None
     } else {
-        c.cache_dir.clone().or_else(default_cache_dir)
+        c.cache_dir
+            .clone()
+            .or_else(super::cache::default_dir)
+            .map(Cache::new)
     };
     let mut out = Vec::new();
     for wall in walls {
-        let (sim, cached) =
-            wall_sim_facts(model_path, model, cell, &wall, &base, cache.as_deref())?;
+        let options = SimOptions {
+            walls: vec![wall.clone()],
+            engine: base.clone(),
+            ..SimOptions::default()
+        };
+        let (sim, counts) = wall_facts_cached(model, cell, &options, cache.as_ref())?;
         facts.extend(sim);
         out.push(Simulated {
             wall,
             label: None,
-            from_cache: cached,
+            from_cache: counts.computed == 0,
         });
     }
     Ok((out, panelized))
@@ -200,14 +208,8 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
     let mut facts = restrict_to_containers(&facts, &containers_of(&facts, &ids));
     add_placement_facts(&mut facts, &cell, &base)?;
-    let (mut simulated, panelized) = simulate_walls(
-        c,
-        &args.model,
-        &model,
-        &cell,
-        &mut facts,
-        std::slice::from_ref(&args.id),
-    )?;
+    let (mut simulated, panelized) =
+        simulate_walls(c, &model, &cell, &mut facts, std::slice::from_ref(&args.id))?;
     let names = panels_by_piece(&plan);
     for s in &mut simulated {
         s.label = names.get(&s.wall).map(PanelOf::label);
@@ -277,7 +279,7 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     }
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs, &base)?;
     let ids = piece_ids_in(&model, &args.tuple);
-    let (_, panelized) = simulate_walls(c, &args.model, &model, &cell, &mut facts, &ids)?;
+    let (_, panelized) = simulate_walls(c, &model, &cell, &mut facts, &ids)?;
     let ctx = Context {
         model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,

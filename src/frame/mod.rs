@@ -6,12 +6,14 @@ pub mod cell_facts;
 pub mod containers;
 pub mod facts;
 pub mod limits;
+pub mod panel;
 pub mod panel_why;
 pub mod panelize;
 pub mod panels;
 pub mod partition;
 pub mod placement;
 pub mod plan;
+mod plan_build;
 pub mod rule_reads;
 
 use crate::logic::compiled::{self, Relations};

@@ -2,7 +2,8 @@
 //! (`STUD~end2`), and `why-not 'panel_break(W1, 7.0)'` for a break that was not made. The
 //! answers come from the plan and the rules' break relations, with the numbers behind them.
 
-use super::panels::{BreakIndex, Panel, TOLERANCE, WallPanels, split_wall};
+use super::panel::{Panel, WallPanels};
+use super::panels::{BreakIndex, TOLERANCE, split_wall};
 use super::plan::{Plan, Wall};
 use crate::cell::{Cell, PanelLimits, PanelMode};
 use crate::logic::compiled::Relations;

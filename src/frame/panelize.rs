@@ -14,52 +14,13 @@
 //! Walls that fit are not touched; a model with no split wall needs no panelized model.
 
 use super::Facts;
+use super::panel::PanelOf;
 use super::plan::{Plan, Wall};
 use crate::geom::OrientedBox;
 use crate::ifc::{Model, Piece};
 use crate::logic::{Origin, Value};
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
-
-/// The wall and panel a piece of the panelized model is built in.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct PanelOf {
-    /// The whole wall's plan id (`W1`, or its group's GlobalId).
-    pub wall_id: String,
-    pub wall_name: String,
-    /// The whole wall's key piece (the rules' name for it).
-    pub wall_key: String,
-    /// `W1-P2`; a wall that fits is its one panel `W1-P1`.
-    pub panel_id: String,
-    /// The panel's number along the wall (from 1); 0 for a wall that fits.
-    pub index: usize,
-}
-
-impl PanelOf {
-    /// What the cell builds, as every command names it: the panel of a split wall (`W1-P2`),
-    /// or the wall that fits (`W1`).
-    pub fn unit_id(&self) -> &str {
-        if self.index > 0 {
-            &self.panel_id
-        } else {
-            &self.wall_id
-        }
-    }
-
-    /// `Wall 1, panel 2` or `Wall 1`.
-    pub fn unit_name(&self) -> String {
-        if self.index > 0 {
-            format!("{}, panel {}", self.wall_name, self.index)
-        } else {
-            self.wall_name.clone()
-        }
-    }
-
-    /// `Wall 1, panel 2 (W1-P2)`, `Wall 1 (W1)`: as `simulate` prints it.
-    pub fn label(&self) -> String {
-        format!("{} ({})", self.unit_name(), self.unit_id())
-    }
-}
 
 /// A model whose split walls are cut into panels.
 pub struct Panelized {

@@ -18,6 +18,7 @@
 //! the break (a segment shorter than `lap` is not made) and the stretch across the joint is a
 //! site piece `PLATE~lapK` (K the first break it spans along the plate), fixed on site.
 
+use super::panel::{AddedPiece, CutPiece, Panel, PanelBreak, SitePiece, WallPanels};
 use super::plan::Wall;
 use crate::cell::PanelLimits;
 use crate::logic::Value;
@@ -56,89 +57,6 @@ pub struct WallBreaks<'a> {
     pub wanted: Vec<(f64, &'a str)>,
     /// (u, reason, piece): why a site is not allowed.
     pub blocked: Vec<(f64, &'a str, &'a str)>,
-}
-
-/// A panel of a wall: the part between two breaks (or the wall's ends).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Panel {
-    /// `WALL-P1`, `WALL-P2`, … along u.
-    pub id: String,
-    /// 1-based, along u.
-    pub index: usize,
-    pub u_start: f64,
-    pub u_end: f64,
-    /// Its pieces' extent up the wall, m.
-    pub height: f64,
-    /// Its pieces' mass, kg (cut plates by their share of the length).
-    pub mass: f64,
-    /// The wall's members that lie whole in this panel, in the wall's member order.
-    pub member_ids: Vec<String>,
-    pub cut_pieces: Vec<CutPiece>,
-    pub added_pieces: Vec<AddedPiece>,
-    /// The limits this panel breaks, in words (empty when it fits).
-    pub exceeds: Vec<String>,
-}
-
-impl Panel {
-    pub fn length(&self) -> f64 {
-        self.u_end - self.u_start
-    }
-}
-
-/// A segment of a plate cut at a break.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CutPiece {
-    /// `PLATE~k`.
-    pub id: String,
-    /// The plate it is cut from.
-    pub of: String,
-    pub u_start: f64,
-    pub u_end: f64,
-    pub mass: f64,
-}
-
-/// An end stud a break adds: a copy of `of` moved along u to `u_start..u_end`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AddedPiece {
-    /// `STUD~endK`.
-    pub id: String,
-    pub of: String,
-    pub role: String,
-    pub u_start: f64,
-    pub u_end: f64,
-    pub mass: f64,
-}
-
-/// The stretch of a lapped plate across a panel joint: fixed on site, in no panel.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SitePiece {
-    /// `PLATE~lapK`.
-    pub id: String,
-    pub of: String,
-    pub u_start: f64,
-    pub u_end: f64,
-    pub mass: f64,
-    /// The panels it laps over, along u.
-    pub laps: Vec<String>,
-}
-
-/// A break the split made.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PanelBreak {
-    pub u: f64,
-    /// Why here, in words.
-    pub reason: String,
-}
-
-/// The split of one wall.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct WallPanels {
-    pub panels: Vec<Panel>,
-    pub breaks: Vec<PanelBreak>,
-    /// Pieces fixed on site across the joints (lapped plates), along u.
-    pub site_pieces: Vec<SitePiece>,
-    /// What the split could not do (limits dropped, wanted breaks not made).
-    pub notes: Vec<String>,
 }
 
 /// Splits one wall. `pieces` in the wall's member order; `roles` gives an added stud's role.

@@ -86,7 +86,7 @@ pub fn add_placement_facts_with(
         return Ok(());
     };
     let first = reason_selected(facts, engine, FIRST_PASS)?;
-    facts.extend(placement_facts_with(cell, &first, min, max, options));
+    facts.extend(placement_facts(cell, &first, min, max, options));
     Ok(())
 }
 
@@ -139,12 +139,7 @@ pub fn candidate_offsets(min: f64, max: f64) -> Vec<f64> {
 /// (every offset with `SearchOptions::every_offset`), `placement_reaches(p, from, to)` for
 /// every run of offsets at which the arm reaches a piece, `placement_nail_reaches(…, from, to)`
 /// the same for nails.
-pub fn placement_facts(cell: &Cell, first: &Reasoned, min: f64, max: f64) -> Facts {
-    placement_facts_with(cell, first, min, max, &SearchOptions::default())
-}
-
-/// `placement_facts` with search options.
-pub fn placement_facts_with(
+pub fn placement_facts(
     cell: &Cell,
     first: &Reasoned,
     min: f64,
@@ -226,7 +221,7 @@ impl Slot {
 type AddFact<'a> = dyn FnMut(&'static str, Vec<Value>, &dyn Fn() -> String) + 'a;
 
 /// The placement facts of one part for the typed runner (`compiled::builtin::run_placed`):
-/// what `placement_facts_with` gives, without origins, each relation sorted.
+/// what `placement_facts` gives, without origins, each relation sorted.
 pub(crate) fn placement_relations(
     cell: &Cell,
     first: &Relations,

@@ -49,9 +49,6 @@ pub fn lookup(name: &str) -> Option<&'static Functor> {
     FUNCTORS.iter().find(|f| f.sig.name == name)
 }
 
-#[allow(dead_code)]
-fn _uses(_: (Iso, OBox, Sym, Vec3, F64)) {}
-
 #[cfg(test)]
 mod tests {
     use super::*;

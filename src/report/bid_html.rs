@@ -209,7 +209,7 @@ pub fn compare_page(model_name: &str, bids: &[Bid], reports: &[&SimReport]) -> S
             head {
                 meta charset="utf-8";
                 title { "Cells compared — " (model_name) }
-                style { (PreEscaped(super::html::STYLE)) "table.bid th { white-space: nowrap; }" }
+                style { (PreEscaped(super::style::STYLE)) "table.bid th { white-space: nowrap; }" }
             }
             body {
                 h1 { "Cells compared on " (model_name) }

@@ -10,8 +10,7 @@
 use super::simulate::SimReport;
 use super::verdict;
 use crate::cell::{Cell, PlacedShape, Shape};
-use crate::sim::Simulation;
-use crate::sim::record::{LumberTrack, PoseTrace, WallRecord};
+use crate::sim::record::{LumberTrack, WallRecord};
 use crate::world::Scene;
 use gltf_json as json;
 use json::validation::Checked::Valid;
@@ -40,17 +39,8 @@ pub fn world_glb(cell: &Cell, scene: &Scene) -> Vec<u8> {
 }
 
 /// One wall's run: the cell, the robot and its lumber, animated over the wall's simulated
-/// time. `None` when the simulation has no record of the wall (by its key).
-pub fn wall_glb(
-    cell: &Cell,
-    sim: &Simulation,
-    report: &SimReport,
-    wall_key: &str,
-) -> Option<Vec<u8>> {
-    scene_wall_glb(cell, &sim.scene, &sim.records, report, wall_key)
-}
-
-/// `wall_glb` from the parts of a simulation it reads (they can be shared between threads).
+/// time, from the parts of a simulation it reads (they can be shared between threads).
+/// `None` when the simulation has no record of the wall (by its key).
 pub fn scene_wall_glb(
     cell: &Cell,
     scene: &Scene,
@@ -743,9 +733,4 @@ fn container(text: &[u8], bin: &[u8]) -> Vec<u8> {
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(bin);
     out
-}
-
-/// The tool0 pose (cell frame) at the trace's samples, for checks.
-pub fn traced_tool(trace: &PoseTrace) -> impl Iterator<Item = (f64, &Isometry3<f64>)> {
-    trace.times.iter().copied().zip(trace.tool.iter())
 }

@@ -23,22 +23,6 @@ use std::path::{Path, PathBuf};
 /// Walls drawn on the index page itself; more get a page each.
 pub const WALLS_PER_PAGE: usize = 8;
 
-pub(super) const STYLE: &str = r#"
-body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 960px; }
-table { border-collapse: collapse; margin: 0.5em 0 1em; font-size: 13px; }
-th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; }
-td.num { text-align: right; font-variant-numeric: tabular-nums; }
-section.wall { border-top: 2px solid #455a64; margin-top: 2em; }
-table.panels tr.this td { font-weight: bold; background: #e3f2fd; }
-.legend span { display: inline-block; padding: 0 6px; margin-right: 6px; border: 1px solid #333; font-size: 12px; }
-.causes li { margin: 0.3em 0; }
-svg { display: block; margin: 0.5em 0; background: #fafafa; border: 1px solid #ddd; }
-svg g.piece:hover rect, svg polygon.piece:hover { stroke-width: 3; }
-rect.op { fill: #90a4ae; } rect.op.feed { fill: #cfd8dc; } rect.op.pick { fill: #42a5f5; }
-rect.op.move { fill: #7e57c2; } rect.op.place { fill: #26a69a; } rect.op.retract { fill: #b0bec5; }
-rect.op.nail { fill: #6d4c41; }
-"#;
-
 /// Everything one report needs.
 pub struct ReportInput<'a> {
     pub model: &'a Model,
@@ -175,7 +159,7 @@ fn page(input: &ReportInput, title: &str, body: Markup) -> Markup {
             head {
                 meta charset="utf-8";
                 title { (title) " — " (input.model_name) }
-                style { (PreEscaped(STYLE)) }
+                style { (PreEscaped(super::style::STYLE)) }
             }
             body { (body) }
         }

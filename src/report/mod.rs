@@ -16,6 +16,8 @@ pub mod png;
 mod pretty_json;
 pub mod role_check;
 pub mod simulate;
+mod simulate_text;
+mod style;
 pub mod svg;
 pub mod verdict;
 pub mod wall_view;

@@ -3,7 +3,7 @@
 
 use super::round_m;
 use crate::cell::PanelLimits;
-use crate::frame::panels::WallPanels;
+use crate::frame::panel::WallPanels;
 use serde::Serialize;
 
 /// Masses to the gram.

@@ -7,7 +7,7 @@ use super::simulate::SimReport;
 use super::verdict;
 use super::wall_view::{PieceView, WallView};
 use crate::cell::Cell;
-use crate::frame::panels::WallPanels;
+use crate::frame::panel::WallPanels;
 use crate::sim::Simulation;
 use maud::{Markup, html};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};

@@ -5,8 +5,8 @@
 use super::causes::{RootCause, root_causes};
 use super::simulate::{PanelRow, SimReport};
 use super::verdict;
-use crate::frame::panelize::PanelOf;
-use crate::frame::panels::WallPanels;
+use crate::frame::panel::PanelOf;
+use crate::frame::panel::WallPanels;
 use crate::ifc::Model;
 use crate::sim::Simulation;
 use crate::sim::record::{NailOutcome, WallRecord};

@@ -195,7 +195,7 @@ impl Simulation {
 }
 
 /// The `rules/sim.dl` facts of some walls' records, in their order.
-fn records_facts(records: &[WallRecord]) -> Facts {
+pub fn records_facts(records: &[WallRecord]) -> Facts {
     let mut facts = Facts::default();
     for r in records {
         facts.extend(r.facts());
@@ -203,16 +203,15 @@ fn records_facts(records: &[WallRecord]) -> Facts {
     facts
 }
 
-/// The `rules/sim.dl` facts of the walls `options.walls` names, without reasoning over
-/// them. Walls named by their key pieces (as `wall_of` names them) are planned from their
-/// spatial containers' facts alone (no rule relates pieces of two containers, see
-/// `frame::containers`), so one wall of a big model costs its storey's reasoning, not the
-/// model's; the facts are those `simulate` gives for the wall.
-pub fn simulate_wall_facts(
+/// A run prepared for the walls `options.walls` names. Walls named by their key pieces (as
+/// `wall_of` names them) are planned from their spatial containers' facts alone (no rule
+/// relates pieces of two containers, see `frame::containers`), so one wall of a big model
+/// costs its storey's reasoning, not the model's; their records are those `simulate` gives.
+pub fn prepare_named_walls(
     model: &Model,
     cell: &Cell,
     options: &SimOptions,
-) -> Result<Facts, SimError> {
+) -> Result<Prepared, SimError> {
     check_options(options)?;
     let facts = whole_facts(model, cell);
     // A wall named otherwise (by name, or by no piece) keeps the whole model.
@@ -231,10 +230,7 @@ pub fn simulate_wall_facts(
         }
     };
     let facts = restrict(facts);
-    let prepared = prepare_facts(model, "model", cell, &options.engine, facts, &restrict)?;
-    let selected = select_walls(&prepared.plan, &options.walls)?;
-    let records = run_prepared(&prepared, cell, options, &selected, &|_, _, _| {})?;
-    Ok(records_facts(&records))
+    prepare_facts(model, "model", cell, &options.engine, facts, &restrict)
 }
 
 /// Runs the walls `selected` (keys, in plan order) of a prepared run in parallel: one record

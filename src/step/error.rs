@@ -1,7 +1,7 @@
 //! Errors of the STEP layer. Every error carries a byte offset; the reader
 //! turns it into `line:column` so that messages point into the file.
 
-use super::source::{ENV_MAX_BYTES, ENV_MAX_DEPTH, ENV_MAX_INSTANCES, ENV_MAX_STRING_BYTES};
+use super::limits::{ENV_MAX_BYTES, ENV_MAX_DEPTH, ENV_MAX_INSTANCES, ENV_MAX_STRING_BYTES};
 use std::fmt;
 
 #[derive(Debug, Clone, PartialEq)]

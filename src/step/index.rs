@@ -2,8 +2,9 @@
 
 use super::error::{StepError, StepErrorKind};
 use super::header::Header;
+use super::limits::ReadOptions;
 use super::params::{self, Entity, skip_ws};
-use super::source::{ReadOptions, Source};
+use super::source::Source;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::path::Path;
@@ -189,18 +190,6 @@ impl StepFile {
             .map(|t| self.by_type[t as usize].as_slice())
             .unwrap_or(&[]);
         ids.iter().map(move |&i| &self.records[i as usize])
-    }
-
-    /// Number of instances of each type name, sorted by name.
-    pub fn type_counts(&self) -> Vec<(&str, usize)> {
-        let mut counts: Vec<(&str, usize)> = self
-            .type_names
-            .iter()
-            .zip(&self.by_type)
-            .map(|(n, v)| (n.as_str(), v.len()))
-            .collect();
-        counts.sort();
-        counts
     }
 
     /// Decodes the parameters of one record.

@@ -8,6 +8,7 @@
 mod error;
 mod header;
 mod index;
+mod limits;
 mod params;
 mod source;
 mod strings;
@@ -15,6 +16,7 @@ mod strings;
 pub use error::{StepError, StepErrorKind};
 pub use header::Header;
 pub use index::{Record, StepFile, TypeId};
+pub use limits::ReadOptions;
 pub use params::{Entity, Param};
-pub use source::{ReadOptions, Source};
+pub use source::Source;
 pub use strings::decode_step_string;

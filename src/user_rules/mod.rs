@@ -14,11 +14,7 @@
 //! A user file may read every base relation but not redefine one: declaring
 //! it again, or deriving into it, is refused naming both places.
 
-pub mod answer;
 pub mod relations_doc;
-pub mod render;
-pub mod sim_cache;
-pub mod why;
 
 use crate::frame::RuleEngine;
 use crate::logic::compiled::{BUILTIN_SOURCES, Relations};

@@ -1,7 +1,9 @@
 //! Compiled engine: `build.rs` turns the built-in rule base (all `rules/*.dl`
-//! as one program, listed as `"rules"`) and every `tests/logic/*.dl` and
-//! `benches/logic/*.dl` (listed by path) into an `ascent!` program with a
-//! wrapper `run(&edb) -> relations` on `Value` tuples.
+//! as one program, listed as `"rules"`) into an `ascent!` program with a
+//! wrapper `run(&edb) -> relations` on `Value` tuples; with the feature
+//! `logic-test-programs` (the crate's own tests and benches) also every
+//! `tests/logic/*.dl`, `benches/logic/*.dl` and Soufflé corpus program the
+//! generator takes, listed by path.
 
 pub mod builtin;
 pub mod rt;

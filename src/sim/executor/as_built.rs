@@ -2,7 +2,7 @@
 
 use super::WallRun;
 use super::framing::box_symmetries;
-use super::nailing::NailPlan;
+use super::nail_plan::NailPlan;
 use crate::sim::record::{NailOutcome, Placement};
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::collections::BTreeMap;

@@ -13,11 +13,12 @@ mod as_built;
 mod carriage;
 mod feeding;
 mod framing;
+mod nail_plan;
 mod nailing;
 mod paths;
 mod stepping;
 
-pub use nailing::NailPlan;
+pub use nail_plan::NailPlan;
 
 use super::SimOptions;
 use super::motion::{JointMove, LinearMove};

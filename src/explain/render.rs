@@ -5,10 +5,10 @@
 //! By default `why` prints the answer first (`render_answer`): each failure's cause with its
 //! numbers and what it led to, then only the causes' trees; `--verbose` prints every tree.
 
-use super::answer::fold_ids;
-use super::why::{Verdict, WhyNotNode, WhyNotReport, WhyReport};
+use super::report::{Verdict, WhyNotNode, WhyNotReport, WhyReport};
+use super::words::{fact, origin_text};
+pub use super::words::{fold_ids, short_value, shorten_numbers};
 use crate::logic::provenance::{Explanation, How, Premise};
-use crate::logic::{Origin, Value};
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
@@ -177,11 +177,6 @@ fn render_verdict(s: &mut String, v: &Verdict, max_depth: usize) {
     );
 }
 
-pub(super) fn fact(e: &Explanation) -> String {
-    let args: Vec<String> = e.tuple.iter().map(short_value).collect();
-    format!("{}({})", e.relation, args.join(", "))
-}
-
 /// Number of nodes under (and including) `e`.
 fn size(e: &Explanation) -> usize {
     match &e.how {
@@ -195,19 +190,6 @@ fn size(e: &Explanation) -> usize {
                 .sum::<usize>()
         }
         _ => 1,
-    }
-}
-
-pub(super) fn origin_text(relation: &str, tuple: &[Value], origin: &Origin) -> String {
-    match origin {
-        Origin::Entity(n) => format!("IFC #{n}"),
-        Origin::File { file, line: 0 } if relation.starts_with("cell_") => {
-            let key = tuple.first().and_then(Value::as_symbol).unwrap_or("");
-            format!("cell {file}, key {key}")
-        }
-        Origin::File { file, line } => format!("{file}:{line}"),
-        Origin::Event(e) => format!("simulation: {e}"),
-        Origin::Rust => "input".to_string(),
     }
 }
 
@@ -420,84 +402,4 @@ fn render_why_not_node(s: &mut String, node: &WhyNotNode, indent: &str) {
 fn relation_of(atom: &str) -> &str {
     let a = atom.trim_start_matches('!');
     a.split('(').next().unwrap_or(a)
-}
-
-/// A value as a person reads it: numbers to 0.1 mm / 6 digits.
-pub fn short_value(v: &Value) -> String {
-    match v {
-        Value::Symbol(s) => format!("{:?}", &**s),
-        Value::Float(x) => short_float(x.0),
-        Value::Vec3(_) | Value::Iso(_) | Value::Box(_) => shorten_numbers(&v.to_string()),
-        other => other.to_string(),
-    }
-}
-
-fn short_float(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let digits = (6 - x.abs().log10().floor() as i32).clamp(0, 9) as usize;
-    let t = format!("{x:.digits$}");
-    let t = if t.contains('.') {
-        t.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        t
-    };
-    if t == "-0" { "0".into() } else { t }
-}
-
-/// Floats with more than 7 significant digits, outside quotes, shortened.
-pub fn shorten_numbers(text: &str) -> String {
-    let mut out = String::new();
-    let chars: Vec<char> = text.chars().collect();
-    let mut i = 0;
-    let mut in_str = false;
-    while i < chars.len() {
-        let c = chars[i];
-        if c == '"' && (i == 0 || chars[i - 1] != '\\') {
-            in_str = !in_str;
-        }
-        let starts_number = !in_str
-            && (c.is_ascii_digit()
-                || (c == '-' && chars.get(i + 1).is_some_and(char::is_ascii_digit)))
-            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_'));
-        if starts_number {
-            let mut j = i + 1;
-            while j < chars.len()
-                && (chars[j].is_ascii_digit()
-                    || chars[j] == '.'
-                    || chars[j] == 'e'
-                    || ((chars[j] == '-' || chars[j] == '+') && chars[j - 1] == 'e'))
-            {
-                j += 1;
-            }
-            let word: String = chars[i..j].iter().collect();
-            match word.parse::<f64>() {
-                Ok(x) if word.contains('.') || word.contains('e') => out.push_str(&short_float(x)),
-                _ => out.push_str(&word),
-            }
-            i = j;
-            continue;
-        }
-        out.push(c);
-        i += 1;
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn numbers_are_shortened_outside_quotes() {
-        assert_eq!(
-            shorten_numbers("x(0.10000000000000001, \"1.23456789\")"),
-            "x(0.1, \"1.23456789\")"
-        );
-        assert_eq!(shorten_numbers("a < 2.3526750000000002"), "a < 2.352675");
-        assert_eq!(shorten_numbers("p_2(-1e-17, 12)"), "p_2(0, 12)");
-        assert_eq!(short_float(1234.56789), "1234.568");
-        assert_eq!(short_float(-0.0000001), "-0.0000001");
-    }
 }

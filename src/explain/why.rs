@@ -5,15 +5,16 @@
 //! explained down to its input facts: IFC entities, cell keys, simulation
 //! events.
 
-use super::answer::{Answer, answer};
-use super::{UserRulesError, full_program};
+use super::answer::answer;
+use super::report::Answer;
+pub use super::report::{ElementInfo, Sources, Verdict, WhyNotNode, WhyNotReport, WhyReport, walk};
 use crate::frame::containers::{containers_of, restrict_to_containers};
-use crate::frame::panelize::PanelOf;
+use crate::frame::panel::PanelOf;
 use crate::frame::{Facts, RuleEngine};
 use crate::ifc::{Model, Piece};
-use crate::logic::provenance::{Explanation, How, Premise, WhyNot, parse_query};
+use crate::logic::provenance::{Explanation, How, parse_query};
 use crate::logic::{Engine, LogicError, Options, Origin, Value};
-use serde::Serialize;
+use crate::user_rules::{UserRulesError, full_program};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -181,71 +182,6 @@ pub fn explaining_engine(
     Ok(engine)
 }
 
-/// The element a report is about.
-#[derive(Clone, Debug, Serialize)]
-pub struct ElementInfo {
-    pub id: String,
-    pub entity: u64,
-    pub item: u64,
-    pub global_id: String,
-    pub ifc_type: String,
-    pub name: Option<String>,
-}
-
-impl ElementInfo {
-    fn of(p: &Piece) -> ElementInfo {
-        ElementInfo {
-            id: p.id.clone(),
-            entity: p.entity,
-            item: p.item,
-            global_id: p.global_id.clone(),
-            ifc_type: p.ifc_type.clone(),
-            name: p.name.clone(),
-        }
-    }
-}
-
-/// What a derivation rests on.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Sources {
-    /// Nodes of the tree (facts and derived tuples).
-    pub facts: usize,
-    /// Rules used, as `label (file:line)`, sorted.
-    pub rules: Vec<String>,
-    /// IFC entities of the model facts, sorted.
-    pub ifc_entities: Vec<u64>,
-    /// Keys of the cell facts (`cell_value`, `cell_choice`) used, sorted.
-    pub cell_keys: Vec<String>,
-    /// Simulation facts used.
-    pub simulation_facts: usize,
-    /// The tree was cut to keep it small (some sources may be missing).
-    pub truncated: bool,
-}
-
-/// One verdict about the element and its derivation.
-#[derive(Clone, Debug, Serialize)]
-pub struct Verdict {
-    pub relation: String,
-    pub tuple: Vec<Value>,
-    pub sources: Sources,
-    pub explanation: Explanation,
-}
-
-/// `why` for one piece.
-#[derive(Clone, Debug, Serialize)]
-pub struct WhyReport {
-    pub element: ElementInfo,
-    /// The element's wall, when it is in one (the rules' name: its key piece).
-    pub wall: Option<String>,
-    /// The wall or panel as every command names it (`W1`, `W1-P2`; see `name_walls`).
-    pub wall_id: Option<String>,
-    /// `Wall 1 (W1)`, `Wall 1, panel 2 (W1-P2)`: as `simulate` prints it.
-    pub wall_label: Option<String>,
-    /// The answer first: causes with their numbers, consequences folded (`answer::answer`).
-    pub answer: Answer,
-    pub verdicts: Vec<Verdict>,
-}
-
 /// Explains every verdict about each piece the ID names.
 pub fn why(ctx: &Context<'_>, id: &str) -> Result<Vec<WhyReport>, WhyError> {
     let pieces = resolve_element(ctx.model, id)?;
@@ -338,39 +274,6 @@ pub fn sources_of(e: &Explanation) -> Sources {
     s.ifc_entities = entities.into_iter().collect();
     s.cell_keys = keys.into_iter().collect();
     s
-}
-
-/// Visits every derived node of a tree depth first, premises in order.
-pub(super) fn walk<'e>(e: &'e Explanation, f: &mut impl FnMut(&'e Explanation)) {
-    f(e);
-    if let How::Rule { premises, .. } = &e.how {
-        for p in premises {
-            if let Premise::Tuple(t) = p {
-                walk(t, f);
-            }
-        }
-    }
-}
-
-/// Why a tuple does not hold: per rule that could derive it, the first
-/// failing condition; nested for failing atoms that are themselves derived.
-#[derive(Clone, Debug, Serialize)]
-pub struct WhyNotNode {
-    pub why_not: WhyNot,
-    /// Why-not of the fully known atoms that failed (derived relations only).
-    pub because: Vec<WhyNotNode>,
-}
-
-#[derive(Clone, Debug, Serialize)]
-#[serde(tag = "answer", rename_all = "snake_case")]
-pub enum WhyNotReport {
-    /// The tuple holds after all: how.
-    Holds {
-        explanation: Explanation,
-    },
-    NotDerived {
-        tree: WhyNotNode,
-    },
 }
 
 /// How deep `why-not` follows failing atoms into the rules that derive them.

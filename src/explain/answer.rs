@@ -4,68 +4,14 @@
 //! …"), the element's statuses and the plan's verdicts in a line. The derivation trees stay in
 //! the report (`--verbose`, `--json`).
 
-use super::why::{Verdict, WhyReport};
+use super::report::{Answer, Cause, Consequence, Status, Verdict, WhyReport};
+use super::words::{fact, origin_text};
 use crate::logic::Value;
 use crate::logic::provenance::{Explanation, How};
-use serde::Serialize;
 use std::collections::BTreeSet;
 
 /// Simulation facts shown under a cause at most.
 const EVIDENCE: usize = 3;
-
-/// The answer for one element.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Answer {
-    /// `framing: failed`, `nailing: failed (0 of 6 nails driven)`, …
-    pub statuses: Vec<Status>,
-    /// The failures' causes, framing first.
-    pub causes: Vec<Cause>,
-    /// Nails not driven because of another piece's failure (nailing reasons of the `Framing`
-    /// component that no cause of this element explains), folded per kind.
-    pub consequences: Vec<Consequence>,
-    /// Findings of the rules (warnings, user rules' violations), one message each.
-    pub findings: Vec<String>,
-    /// What the plan decided, in words (`role bottom_plate`, `assembly rank 3`).
-    pub plan: Vec<String>,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct Status {
-    pub stage: String,
-    pub status: String,
-    /// Nails driven and planned, for nailing.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub nails: Option<(i64, i64)>,
-}
-
-/// One cause of a failure: the rule's message with its numbers, the facts it rests on.
-#[derive(Clone, Debug, Serialize)]
-pub struct Cause {
-    pub stage: String,
-    pub component: String,
-    /// The rule's message; for nails folded together, the first one's, with `subjects`.
-    pub message: String,
-    /// The rule that derived it, `name (file:line)`.
-    pub rule: String,
-    /// The nails it is about (`PLATE -> MEMBER #k`), when it is about nails.
-    pub subjects: Vec<String>,
-    /// The simulation facts it rests on, as `fact  [origin]`.
-    pub evidence: Vec<String>,
-    /// What it led to, one entry per kind.
-    pub consequences: Vec<Consequence>,
-    /// The verdict (index into the report's `verdicts`) whose tree explains it.
-    pub verdict: usize,
-}
-
-/// Verdicts that follow from a cause, folded.
-#[derive(Clone, Debug, Serialize)]
-pub struct Consequence {
-    /// `nails not driven because it was not placed`.
-    pub kind: String,
-    pub count: usize,
-    /// `PLATE -> MEMBER #k` of each.
-    pub ids: Vec<String>,
-}
 
 /// A nail's reason split into the nail it names and what it says of it.
 struct NailReason<'a> {
@@ -117,8 +63,8 @@ fn evidence(e: &Explanation) -> Vec<String> {
         {
             let line = format!(
                 "{}  [{}]",
-                super::render::fact(node),
-                super::render::origin_text(&node.relation, &node.tuple, origin)
+                fact(node),
+                origin_text(&node.relation, &node.tuple, origin)
             );
             if seen.insert(line.clone()) {
                 out.push(line);
@@ -253,34 +199,6 @@ fn cause(
     }
 }
 
-/// Nails listed compactly: `A -> B #1, #2; A -> C #1`.
-pub fn fold_ids(ids: &[String]) -> String {
-    let mut groups: Vec<(&str, Vec<&str>)> = Vec::new();
-    for id in ids {
-        let (pair, k) = id.rsplit_once(" #").unwrap_or((id, ""));
-        match groups.iter_mut().find(|(p, _)| *p == pair) {
-            Some((_, ks)) => ks.push(k),
-            None => groups.push((pair, vec![k])),
-        }
-    }
-    groups
-        .iter()
-        .map(|(pair, ks)| {
-            let ks: Vec<String> = ks
-                .iter()
-                .filter(|k| !k.is_empty())
-                .map(|k| format!("#{k}"))
-                .collect();
-            if ks.is_empty() {
-                pair.to_string()
-            } else {
-                format!("{pair} {}", ks.join(", "))
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("; ")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,14 +225,5 @@ mod tests {
         let n = nail_reason("nail P -> M #1: P was not placed").unwrap();
         assert_eq!(in_words(&n, "P"), "it was not placed");
         assert_eq!(in_words(&n, "M"), "the other piece was not placed");
-    }
-
-    #[test]
-    fn nails_fold_by_pair() {
-        let ids: Vec<String> = ["A -> B #1", "A -> B #2", "A -> C #1"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
-        assert_eq!(fold_ids(&ids), "A -> B #1, #2; A -> C #1");
     }
 }
