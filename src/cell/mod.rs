@@ -11,6 +11,8 @@ mod error;
 mod ik;
 pub mod io;
 mod layout;
+mod layout_file;
+mod layout_parse;
 mod load;
 mod meta;
 mod opw;

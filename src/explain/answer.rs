@@ -57,7 +57,7 @@ fn rule_of(e: &Explanation) -> String {
 /// The simulation facts (inputs with a simulation origin) a tree rests on, first seen first.
 fn evidence(e: &Explanation) -> Vec<String> {
     let (mut out, mut seen) = (Vec::new(), BTreeSet::new());
-    super::why::walk(e, &mut |node| {
+    super::report::walk(e, &mut |node| {
         if let How::Input { origin } = &node.how
             && matches!(origin, crate::logic::Origin::Event(_))
         {
@@ -77,7 +77,7 @@ fn evidence(e: &Explanation) -> Vec<String> {
 /// The first tuple of `relation` in a tree.
 fn find<'e>(e: &'e Explanation, relation: &str) -> Option<&'e Explanation> {
     let mut found = None;
-    super::why::walk(e, &mut |node| {
+    super::report::walk(e, &mut |node| {
         if found.is_none() && node.relation == relation {
             found = Some(node);
         }
