@@ -120,6 +120,9 @@ fn main() {
         table.push(("rules".to_string(), "builtin_rules".to_string()));
         out.push_str(&placed_slice(&program, "builtin_rules", "builtin_placed"));
         out.push_str(&plan_scope(&program));
+        let rows = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
+            .join("framing_rows.rs");
+        std::fs::write(&rows, typed_rows(&program)).expect("write the typed rows");
     }
     if test_programs {
         test_and_bench_programs(&root, &mut out, &mut table);
@@ -240,4 +243,100 @@ fn placed_slice(program: &front::Program, base: &str, name: &str) -> String {
     }
     code.push_str("    }\n}\n");
     code
+}
+
+/// One struct per relation of the built-in rule base, its fields named and typed as its
+/// `.decl` says, read from a tuple by `frame::rows::Row::read` (see `src/frame/rows.rs`).
+fn typed_rows(program: &front::Program) -> String {
+    let mut code = String::new();
+    for rel in &program.relations {
+        let name: String = rel
+            .name
+            .split(['_', '?'])
+            .filter(|w| !w.is_empty())
+            .map(|w| {
+                let mut c = w.chars();
+                c.next()
+                    .map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
+            })
+            .collect();
+        let fields: Vec<(String, &str, &str)> = rel
+            .attrs
+            .iter()
+            .map(|a| {
+                let (ty, read) = match a.ty {
+                    BaseTy::Number => ("i64", "as_number"),
+                    BaseTy::Unsigned => ("u64", "as_unsigned"),
+                    BaseTy::Float => ("f64", "as_float"),
+                    BaseTy::Symbol => ("&'static str", "as_sym"),
+                    BaseTy::Vec3 => ("nalgebra::Vector3<f64>", "as_vec3"),
+                    BaseTy::Iso => ("nalgebra::Isometry3<f64>", "as_iso"),
+                    BaseTy::Box => ("crate::logic::OBox", "as_box"),
+                };
+                (field_name(&a.name), ty, read)
+            })
+            .collect();
+        let decl: Vec<String> = rel
+            .attrs
+            .iter()
+            .map(|a| format!("{}: {}", a.name, a.ty_name))
+            .collect();
+        let _ = writeln!(code, "/// `{}({})`", rel.name, decl.join(", "));
+        code.push_str("#[derive(Debug, Clone, PartialEq)]\n");
+        let _ = writeln!(code, "pub struct {name} {{");
+        for (f, ty, _) in &fields {
+            let _ = writeln!(code, "    pub {f}: {ty},");
+        }
+        code.push_str("}\n");
+        let _ = writeln!(code, "impl Row for {name} {{");
+        let _ = writeln!(code, "    const RELATION: &'static str = {:?};", rel.name);
+        let _ = writeln!(
+            code,
+            "    const DECL: &'static str = {:?};",
+            decl.join(", ")
+        );
+        code.push_str("    fn read(t: &[Value]) -> Option<Self> {\n");
+        let vars: Vec<String> = (0..fields.len()).map(|i| format!("v{i}")).collect();
+        let _ = writeln!(
+            code,
+            "        let [{}] = t else {{ return None }};",
+            vars.join(", ")
+        );
+        let _ = writeln!(code, "        Some({name} {{");
+        for ((f, _, read), v) in fields.iter().zip(&vars) {
+            let value = match *read {
+                "as_sym" => format!("{v}.as_sym()?.as_str()"),
+                _ => format!("{v}.{read}()?"),
+            };
+            let _ = writeln!(code, "            {f}: {value},");
+        }
+        code.push_str("        })\n    }\n}\n");
+    }
+    code
+}
+
+/// A `.decl` attribute name as a Rust field name.
+fn field_name(attr: &str) -> String {
+    const KEYWORDS: &[&str] = &[
+        "as", "box", "break", "const", "continue", "crate", "else", "enum", "extern", "false",
+        "fn", "for", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub",
+        "ref", "return", "self", "static", "struct", "super", "trait", "true", "type", "unsafe",
+        "use", "where", "while", "async", "await", "dyn", "abstract", "become", "do", "final",
+        "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
+    ];
+    let snake: String = attr
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if KEYWORDS.contains(&snake.as_str()) {
+        format!("{snake}_")
+    } else {
+        snake
+    }
 }

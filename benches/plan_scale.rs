@@ -120,7 +120,7 @@ fn plan_cached(path: &Path, cache: &Cache, label: &str) -> (f64, blake3::Hash) {
     let cell = Cell::load("study-abb").expect("cell");
     let mut facts = model_facts(&model, &Default::default());
     facts.extend(cell_facts(&cell));
-    let limits = RuleLimits::from_env().expect("limits");
+    let limits = RuleLimits::default();
     let (_reasoned, counts, plan) = reason_plan_cached_with(facts, &cell, cache, &limits, |r| {
         Plan::from_relations(&model, r)
     })

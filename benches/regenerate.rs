@@ -13,15 +13,16 @@
 //! `-- --plan-only` for the plan rows alone).
 //! The full simulation is not repeated: this is a bench command, not a criterion sample.
 
-use framewright::cache::{Cache, reason_plan_cached, simulate_cached};
+use framewright::cache::{Cache, reason_plan_cached};
 use framewright::cell::Cell;
 use framewright::frame::placement::add_placement_facts;
 use framewright::frame::plan::Plan;
 use framewright::frame::{RuleEngine, RuleLimits, cell_facts, model_facts, reason_selected};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
+use framewright::pipeline::Run;
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, simulate_with_progress};
+use framewright::sim::SimOptions;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
@@ -149,7 +150,6 @@ fn main() {
         ..SimOptions::default()
     };
     let name = "g_scale_3storey.ifc";
-    let nothing = |_: &str, _: usize, _: usize| {};
 
     let (edited_text, stud) = move_a_stud(&std::fs::read_to_string(&path).unwrap());
     let edited_path = dir.path().join(name);
@@ -161,7 +161,12 @@ fn main() {
 
     let t = Instant::now();
     let model = Model::open(&path).unwrap();
-    let (full, counts) = simulate_cached(&model, name, &cell, &options, &cache, &nothing).unwrap();
+    let (full, counts) = Run::new(&model, &cell, &options)
+        .named(name)
+        .cache(Some(&cache))
+        .simulate()
+        .unwrap();
+    let counts = counts.expect("a cached run counts");
     let full_s = t.elapsed().as_secs_f64();
     println!(
         "full simulate (empty cache): {full_s:.1} s, {} walls simulated",
@@ -171,8 +176,12 @@ fn main() {
 
     let t = Instant::now();
     let edited = Model::open(&edited_path).unwrap();
-    let (regen, counts) =
-        simulate_cached(&edited, name, &cell, &options, &cache, &nothing).unwrap();
+    let (regen, counts) = Run::new(&edited, &cell, &options)
+        .named(name)
+        .cache(Some(&cache))
+        .simulate()
+        .unwrap();
+    let counts = counts.expect("a cached run counts");
     let regen_s = t.elapsed().as_secs_f64();
     println!(
         "regenerate after moving stud {stud} 20 mm: {regen_s:.2} s ({:.2} % of the full run), \
@@ -183,7 +192,10 @@ fn main() {
     );
 
     let t = Instant::now();
-    let uncached = simulate_with_progress(&edited, name, &cell, &options, &nothing).unwrap();
+    let (uncached, _) = Run::new(&edited, &cell, &options)
+        .named(name)
+        .simulate()
+        .unwrap();
     println!(
         "edited model without the cache: {:.1} s",
         t.elapsed().as_secs_f64()

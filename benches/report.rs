@@ -8,12 +8,14 @@
 //! Run: `cargo bench --bench report`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use framewright::cache::{Cache, Need, simulate_cached_for};
+use framewright::cache::{Cache, Need};
 use framewright::cell::Cell;
 use framewright::ifc::Model;
+use framewright::pipeline::Run;
+use framewright::pipeline::simulate;
 use framewright::report::html::{ReportInput, report_files};
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, simulate};
+use framewright::sim::SimOptions;
 use std::path::Path;
 use std::time::Instant;
 
@@ -73,16 +75,13 @@ fn building() {
     let options = SimOptions::default();
     let cache = Cache::new(root().join("target/report-bench-cache"));
     let start = Instant::now();
-    let (sim, counts) = simulate_cached_for(
-        Need::Traces,
-        &model,
-        "g_scale_3storey.ifc",
-        &cell,
-        &options,
-        &cache,
-        &|_, _, _| {},
-    )
-    .expect("simulation");
+    let (sim, counts) = Run::new(&model, &cell, &options)
+        .named("g_scale_3storey.ifc")
+        .cache(Some(&cache))
+        .need(Need::Traces)
+        .simulate()
+        .expect("simulation");
+    let counts = counts.expect("a cached run counts");
     let simulating = start.elapsed().as_secs_f64();
     let report = SimReport::new(&sim, options.dt);
     let input = ReportInput {

@@ -9,7 +9,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use framewright::cell::Cell;
 use framewright::ifc::Model;
-use framewright::sim::{SimOptions, Stepping, simulate};
+use framewright::pipeline::simulate;
+use framewright::sim::{SimOptions, Stepping};
 use std::path::Path;
 use std::time::Instant;
 

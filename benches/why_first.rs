@@ -1,18 +1,18 @@
 //! The simulation behind a first `why` on an element of the 4,020-member model
 //! (`../shared/ifc-testcases/g_scale_3storey.ifc`, skipped when absent): the element's wall
 //! simulated as `why` did before (the whole model planned, the run reasoned over afterwards:
-//! `simulate(..).facts`) and as it does now (`cache::wall_facts_cached`: the wall's storey alone,
+//! `simulate(..).facts`) and as it does now (`pipeline::Run::wall_facts`: the wall's storey alone,
 //! no reasoning afterwards), in the same run, with the ratio. Both must give the same facts.
 //!
 //! `cargo bench --bench why_first [-- ID]` (default `#20002`, a jack stud of a 228-piece wall).
 
-use framewright::cache::wall_facts_cached;
 use framewright::cell::Cell;
 use framewright::explain::why::{Context, element_walls};
 use framewright::frame::{RuleEngine, cell_facts, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
-use framewright::sim::{SimOptions, simulate};
+use framewright::pipeline::{Run, simulate};
+use framewright::sim::SimOptions;
 use std::path::Path;
 use std::time::Instant;
 
@@ -49,7 +49,8 @@ fn main() {
         .facts;
     let whole = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    let now = wall_facts_cached(&model, &cell, &options, None)
+    let now = Run::new(&model, &cell, &options)
+        .wall_facts()
         .map(|(facts, _)| facts)
         .expect("one-storey run");
     let alone = start.elapsed().as_secs_f64();

@@ -15,6 +15,7 @@ pub mod frame;
 pub mod geom;
 pub mod ifc;
 pub mod logic;
+pub mod pipeline;
 pub mod program;
 pub mod report;
 pub mod sim;

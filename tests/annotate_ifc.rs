@@ -5,8 +5,8 @@
 
 mod common;
 
+use framewright::step::text::string as step_string;
 use framewright::step::{ReadOptions, StepFile};
-use framewright::synth::step_text::string as step_string;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

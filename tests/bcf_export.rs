@@ -287,7 +287,7 @@ fn hostile_names_survive() {
     let hostile_line = format!(
         "{}{}{}",
         &line[..name_start],
-        framewright::synth::step_text::string(HOSTILE),
+        framewright::step::text::string(HOSTILE),
         &line[name_end..]
     );
     let model: PathBuf = dir.path().join("tm1 'x' <&> é.ifc");

@@ -8,7 +8,8 @@
 use framewright::cell::Cell;
 use framewright::frame::RuleEngine;
 use framewright::ifc::Model;
-use framewright::sim::{SimOptions, simulate};
+use framewright::pipeline::simulate;
+use framewright::sim::SimOptions;
 use framewright::user_rules::{Finding, UserRules};
 use serde_json::Value as Json;
 use std::collections::BTreeSet;

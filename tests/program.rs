@@ -7,8 +7,9 @@ mod program_reader;
 
 use framewright::cell::Cell;
 use framewright::ifc::Model;
+use framewright::pipeline::simulate;
+use framewright::sim::SimOptions;
 use framewright::sim::record::RobotStep;
-use framewright::sim::{SimOptions, simulate};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use program_reader::{krl, rapid};
 use serde_json::Value;

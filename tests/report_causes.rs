@@ -3,10 +3,11 @@
 
 use framewright::cell::Cell;
 use framewright::ifc::Model;
+use framewright::pipeline::simulate;
 use framewright::report::causes::root_causes;
 use framewright::report::simulate::SimReport;
+use framewright::sim::SimOptions;
 use framewright::sim::record::NailOutcome;
-use framewright::sim::{SimOptions, simulate};
 use std::collections::BTreeSet;
 use std::path::Path;
 

@@ -8,10 +8,13 @@ mod common;
 use common::browser::{browse, chromium, console_errors};
 use framewright::cell::Cell;
 use framewright::ifc::Model;
-use framewright::report::html::{ReportInput, report_files, write_report};
+use framewright::pipeline::simulate;
+use framewright::report::html::{
+    DEFAULT_MAX_REPORT_BYTES, ReportInput, report_files, write_report,
+};
 use framewright::report::simulate::SimReport;
 use framewright::report::verdict;
-use framewright::sim::{SimOptions, Simulation, simulate};
+use framewright::sim::{SimOptions, Simulation};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use regex::Regex;
 use std::collections::BTreeMap;
@@ -74,6 +77,7 @@ fn write(r: &Run, dir: &Path) {
             sim: &r.sim,
             report: &r.report,
         },
+        DEFAULT_MAX_REPORT_BYTES,
     )
     .expect("report written");
 }
@@ -416,6 +420,7 @@ fn writing_over_a_folder_that_is_no_report_is_refused() {
             sim: &r.sim,
             report: &r.report,
         },
+        DEFAULT_MAX_REPORT_BYTES,
     )
     .unwrap_err();
     assert!(err.to_string().contains("no earlier report"), "{err}");

@@ -6,9 +6,10 @@ mod common;
 
 use framewright::cell::Cell;
 use framewright::ifc::Model;
+use framewright::pipeline::simulate;
 use framewright::report::simulate::SimReport;
 use framewright::sim::record::NailOutcome;
-use framewright::sim::{SimOptions, Simulation, Stepping, simulate};
+use framewright::sim::{SimOptions, Simulation, Stepping};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

@@ -3,8 +3,9 @@
 
 use framewright::cell::Cell;
 use framewright::ifc::Model;
+use framewright::pipeline::simulate;
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, Simulation, simulate};
+use framewright::sim::{SimOptions, Simulation};
 use std::path::Path;
 
 fn model(name: &str) -> Model {

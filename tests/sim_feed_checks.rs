@@ -9,8 +9,9 @@ mod common;
 
 use framewright::cell::Cell;
 use framewright::ifc::Model;
+use framewright::pipeline::simulate;
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, Simulation, simulate};
+use framewright::sim::{SimOptions, Simulation};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

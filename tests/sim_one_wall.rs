@@ -1,15 +1,15 @@
-//! `cache::wall_facts_cached` (what `why` simulates for one element's wall) plans the wall from its
+//! `pipeline::Run::wall_facts` (what `why` simulates for one element's wall) plans the wall from its
 //! storey's facts alone; its facts must be the ones a simulation of the whole model gives
 //! for that wall.
 
 mod common;
 
-use framewright::cache::wall_facts_cached;
 use framewright::cell::Cell;
 use framewright::frame::{cell_facts, model_facts, reason};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
-use framewright::sim::{SimOptions, simulate};
+use framewright::pipeline::{Run, simulate};
+use framewright::sim::SimOptions;
 use std::path::Path;
 
 /// A generated block of two storeys (two spatial containers), walls grouped in IfcWall.
@@ -84,7 +84,8 @@ fn one_wall_from_its_storey_gives_the_facts_of_a_whole_model_run() {
     let whole = simulate(&model, &cell, &options)
         .expect("whole-model run")
         .facts;
-    let alone = wall_facts_cached(&model, &cell, &options, None)
+    let alone = Run::new(&model, &cell, &options)
+        .wall_facts()
         .map(|(facts, _)| facts)
         .expect("one-wall run");
     assert!(
@@ -110,7 +111,8 @@ fn an_unknown_wall_is_an_error_naming_it() {
         walls: vec!["no such wall".into()],
         ..SimOptions::default()
     };
-    let err =
-        wall_facts_cached(&model, &cell, &options, None).expect_err("an unknown wall is an error");
+    let err = Run::new(&model, &cell, &options)
+        .wall_facts()
+        .expect_err("an unknown wall is an error");
     assert!(err.to_string().contains("no such wall"), "{err}");
 }

@@ -4,8 +4,9 @@
 
 use framewright::cell::{Cell, IkFailure};
 use framewright::ifc::Model;
+use framewright::pipeline::simulate;
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, Simulation, simulate};
+use framewright::sim::{SimOptions, Simulation};
 use nalgebra::Point3;
 use std::path::Path;
 

@@ -12,8 +12,9 @@
 use framewright::cell::Cell;
 use framewright::frame::plan::Plan;
 use framewright::ifc::Model;
+use framewright::pipeline::simulate;
 use framewright::report::simulate::{SimReport, WallRow};
-use framewright::sim::{SimOptions, simulate};
+use framewright::sim::SimOptions;
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
 use std::path::Path;

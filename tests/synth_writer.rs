@@ -1,10 +1,10 @@
 //! The IFC writer: output is well-formed STEP (checked by a small independent
 //! parser here), byte-deterministic, schema-correct in attribute counts, and its
 //! placements put every piece where the truth sidecar says.
+use framewright::ifc::guid;
+use framewright::step::text::string;
 use framewright::synth::building::grid;
-use framewright::synth::guid;
 use framewright::synth::models;
-use framewright::synth::step_text::string;
 use framewright::synth::units::LengthUnit;
 use framewright::synth::{
     Grouping, Layout, PlacementBase, ProductClasses, Schema, SynthError, WriteOptions, write_ifc,

@@ -3,7 +3,6 @@
 //! verdict rule down to the executor's fact, the IFC entities and the cell keys. The numbers
 //! in it are checked against the arm's own kinematic chain and the plate's place.
 
-use framewright::cache::wall_facts_cached;
 use framewright::cell::Cell;
 use framewright::explain::render::render_why;
 use framewright::explain::why::{Context, WhyReport, why};
@@ -12,6 +11,7 @@ use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::logic::provenance::{How, Premise};
 use framewright::logic::{Explanation, Origin, Value};
+use framewright::pipeline::Run;
 use framewright::sim::SimOptions;
 use nalgebra::Vector3;
 use std::path::Path;
@@ -45,7 +45,8 @@ fn facts(model: &Model, sim: bool) -> Facts {
             ..SimOptions::default()
         };
         facts.extend(
-            wall_facts_cached(model, &cell, &options, None)
+            Run::new(model, &cell, &options)
+                .wall_facts()
                 .map(|(facts, _)| facts)
                 .expect("W1 simulates"),
         );

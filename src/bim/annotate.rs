@@ -26,7 +26,7 @@ use super::verdicts::ElementVerdict;
 use crate::frame::plan::{Plan, Wall};
 use crate::ifc::{Model, Piece, Schema};
 use crate::step::StepFile;
-use crate::synth::step_text::{Real, RealList, Ref, RefList, string};
+use crate::step::text::{Real, RealList, Ref, RefList, string};
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
 

@@ -2,8 +2,8 @@
 //! IFC's limits, GlobalIds derived from what they name, bodies and properties.
 
 use super::step_edit::Appender;
-use crate::synth::guid;
-use crate::synth::step_text::{Real, Ref, string};
+use crate::ifc::guid;
+use crate::step::text::{Real, Ref, string};
 
 /// Name of the property set written on every element.
 pub const PSET_NAME: &str = "Framewright_Assembly";

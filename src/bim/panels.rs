@@ -20,7 +20,7 @@ use crate::frame::panelize::{moved_box, segment_box};
 use crate::frame::plan::Plan;
 use crate::geom::OrientedBox;
 use crate::ifc::Piece;
-use crate::synth::step_text::{Real, RealList, Ref, RefList, string};
+use crate::step::text::{Real, RealList, Ref, RefList, string};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// What `write_panels` added.

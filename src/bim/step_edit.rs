@@ -4,7 +4,7 @@
 //! highest id in use.
 
 use crate::step::StepFile;
-use crate::synth::step_text::Ref;
+use crate::step::text::Ref;
 use std::fmt::{Display, Write};
 use std::ops::Range;
 

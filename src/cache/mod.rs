@@ -13,8 +13,6 @@ pub mod value_codec;
 
 pub use plan::{reason_plan_cached, reason_plan_cached_with};
 pub use plan_writer::PlanWriter;
-pub use sim::{
-    CacheCounts, Need, Shard, ShardRun, cached_simulation, simulate_cached, simulate_cached_for,
-    simulate_shard, wall_facts_cached,
-};
+pub use sim::{CacheCounts, Need, Shard, ShardError, ShardRun};
+pub(crate) use sim::{look_up, store};
 pub use store::{Cache, CacheInfo, clear, info};

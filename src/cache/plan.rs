@@ -16,6 +16,7 @@ use crate::frame::placement::{
     FIRST_PASS, SearchMemo, SearchOptions, placement_relations, reason_placed,
 };
 use crate::frame::plan::Plan;
+use crate::frame::rows::{PieceContainer, rows_of};
 use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, RuleLimits};
 use crate::logic::compiled::{Relations, builtin};
 use crate::logic::functors::defs::{box_centre, box_radius, dot};
@@ -287,11 +288,9 @@ impl Job {
             Job::Part(i) => {
                 let mut input = partition.relations(facts, &[*i], Indices::Renumbered);
                 let context = partition.context(facts, *i);
-                let others: FxHashSet<&str> = context
-                    .get("piece_container")
+                let others: FxHashSet<&str> = rows_of::<PieceContainer>(&context)?
                     .into_iter()
-                    .flatten()
-                    .filter_map(|t| t.first()?.as_symbol())
+                    .map(|row| row.p)
                     .collect();
                 for (name, tuples) in &context {
                     input
@@ -328,7 +327,7 @@ fn reason_part(
         }),
         OffsetX::Fixed { .. } => builtin::run_selected(&input, &wanted),
     }
-    .map_err(FrameError::Compiled)?;
+    .map_err(FrameError::CompiledRun)?;
     Ok((run.relations, run.tuples))
 }
 

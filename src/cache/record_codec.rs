@@ -7,7 +7,7 @@
 use crate::cell::IkFailure;
 use crate::sim::WallRecord;
 use crate::sim::record::{
-    BeltEvent, ContactRecord, IkRecord, NailOutcome, NailRecord, Operation, Placement, Refusal,
+    BeltEvent, ContactRecord, IkRecord, NailOutcome, NailRecord, Op, Operation, Placement, Refusal,
     RefusalKind,
 };
 use serde::{Deserialize, Serialize};
@@ -67,7 +67,7 @@ impl std::io::Write for HashSink<'_> {
     }
 }
 
-/// The executor names its operations, belts and events with `&'static str`; rebuilt records
+/// The executor names its belts and events with `&'static str`; rebuilt records
 /// borrow each distinct name from this set, which holds a handful of words. An entry with
 /// more distinct names than any executor uses is not a record.
 fn intern(name: String) -> Option<&'static str> {
@@ -349,7 +349,7 @@ impl Rec {
         for (piece, op, start, end) in self.operations {
             operations.push(Operation {
                 piece,
-                op: intern(op)?,
+                op: Op::from_name(&op)?,
                 start: float(start),
                 end: float(end),
             });
@@ -358,7 +358,7 @@ impl Rec {
         for (piece, op, result) in self.ik {
             ik.push(IkRecord {
                 piece,
-                op: intern(op)?,
+                op: Op::from_name(&op)?,
                 result: result.map(float).map_err(IkFailureBits::into_failure),
             });
         }
@@ -366,7 +366,7 @@ impl Rec {
         for (piece, op, t, body_a, body_b, depth) in self.contacts {
             contacts.push(ContactRecord {
                 piece,
-                op: intern(op)?,
+                op: Op::from_name(&op)?,
                 t: float(t),
                 body_a,
                 body_b,
@@ -464,19 +464,19 @@ mod tests {
             wall: "2Ab$x".into(),
             operations: vec![Operation {
                 piece: "p1".into(),
-                op: "pick",
+                op: Op::Pick,
                 start: 0.1 + 0.2,
                 end: f64::INFINITY,
             }],
             ik: vec![
                 IkRecord {
                     piece: "p1".into(),
-                    op: "place",
+                    op: Op::Place,
                     result: Ok(1e-300),
                 },
                 IkRecord {
                     piece: "p2".into(),
-                    op: "pick",
+                    op: Op::Pick,
                     result: Err(IkFailure::JointLimit {
                         joint: "joint_3".into(),
                         value: 1.428,

@@ -36,6 +36,12 @@ pub enum CellError {
     },
 }
 
+/// A setting given as text (a command-line option, a cell key) that is not acceptable, or a
+/// pick point the robot cannot reach: what is wrong; the caller names where it came from.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct InvalidValue(pub String);
+
 impl CellError {
     pub(crate) fn urdf(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         CellError::Urdf {

@@ -4,6 +4,7 @@
 //!
 //! Loading a cell from its TOML file is in `layout_parse.rs`.
 
+use super::error::InvalidValue;
 use super::io::Io;
 use super::panels::{PanelLimits, PanelMode};
 use super::robot::Robot;
@@ -26,7 +27,7 @@ pub enum OffsetX {
 
 impl OffsetX {
     /// Parses a command-line or file value: metres or `auto` (searched over `range`).
-    pub fn parse(text: &str, range: [f64; 2]) -> Result<OffsetX, String> {
+    pub fn parse(text: &str, range: [f64; 2]) -> Result<OffsetX, InvalidValue> {
         if text.trim() == "auto" {
             return Ok(OffsetX::Auto {
                 min: range[0],
@@ -37,9 +38,9 @@ impl OffsetX {
         // hanging over the middle of the table.
         match text.trim().parse::<f64>() {
             Ok(x) if x.is_finite() && (-100.0..=100.0).contains(&x) => Ok(OffsetX::Fixed { x }),
-            _ => Err(format!(
+            _ => Err(InvalidValue(format!(
                 "expected a distance in m from -100 to 100 or \"auto\", got {text:?}"
-            )),
+            ))),
         }
     }
 }
@@ -287,7 +288,7 @@ impl Cell {
     }
 
     /// Overrides the cell's `offset_x` (a distance in m, or `auto`), as the command line does.
-    pub fn set_offset_x(&mut self, text: &str) -> Result<(), String> {
+    pub fn set_offset_x(&mut self, text: &str) -> Result<(), InvalidValue> {
         self.assembly.offset_x = OffsetX::parse(text, self.assembly.auto_range)?;
         Ok(())
     }

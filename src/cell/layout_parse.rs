@@ -3,7 +3,7 @@
 //! and the `Cell` they build, its pick point checked for reach.
 
 use super::builtin;
-use super::error::CellError;
+use super::error::{CellError, InvalidValue};
 use super::ik::IkFailure;
 use super::layout::{
     Assembly, Cell, Conveyor, Creep, Floor, Motion, OffsetX, Pick, ToolTable, TouchSensor,
@@ -110,17 +110,17 @@ impl Cell {
             panel_mode: PanelMode::default(),
         };
         cell.check_pick(&s.pick_heights)
-            .map_err(|m| file.bad("touch_sensor", "pick_offset", m))?;
+            .map_err(|m| file.bad("touch_sensor", "pick_offset", m.0))?;
         Ok(cell)
     }
 
     /// The pick point must be reachable, with the grip TCP, for every checked lumber height,
     /// with at least `min_reach_margin` of reach to spare.
-    fn check_pick(&mut self, heights: &[f64]) -> Result<(), String> {
+    fn check_pick(&mut self, heights: &[f64]) -> Result<(), InvalidValue> {
         let tcp = *self
             .tool
             .tcp("grip")
-            .ok_or("the tool has no `grip` TCP to pick with")?;
+            .ok_or_else(|| InvalidValue("the tool has no `grip` TCP to pick with".into()))?;
         let home = self.robot.home();
         // On a track the carriage picks from abeam of the pick point.
         let (base, carriage) = match &self.track {
@@ -139,21 +139,21 @@ impl Cell {
                 p.x, p.y, p.z
             );
             if let Err(fail) = self.robot.ik(&pose, &tcp, &home) {
-                return Err(match fail {
+                return Err(InvalidValue(match fail {
                     IkFailure::OutOfReach {
                         distance, reach, ..
                     } => format!(
                         "{at} is out of reach: wrist centre {distance:.3} m from the shoulder, reach {reach:.3} m; move the conveyor or the robot"
                     ),
                     other => format!("{at} is not reachable: {other}"),
-                });
+                }));
             }
             if let Some(margin) = self.robot.reach_margin(&pose, &tcp) {
                 if margin < self.pick.min_reach_margin {
-                    return Err(format!(
+                    return Err(InvalidValue(format!(
                         "{at} is reachable with only {margin:.3} m to spare; at least {:.3} m (touch_sensor.min_reach_margin) is required",
                         self.pick.min_reach_margin
-                    ));
+                    )));
                 }
                 margins.push((h, margin));
             }
@@ -293,7 +293,7 @@ fn parse_assembly(
         OffsetSetting::Metres(x) => OffsetX::parse(&x.to_string(), auto_range),
         OffsetSetting::Word(w) => OffsetX::parse(w, auto_range),
     }
-    .map_err(|m| file.bad("assembly", "offset_x", m))?;
+    .map_err(|m| file.bad("assembly", "offset_x", m.0))?;
     file.coord("assembly", "centre_y", &[a.centre_y])?;
     file.coord("assembly", "surface_z", &[a.surface_z])?;
     Ok(Assembly {

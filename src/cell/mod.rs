@@ -26,7 +26,7 @@ pub mod track;
 mod urdf_depth;
 
 pub use builtin::{cell_names, robot_names, tool_names};
-pub use error::CellError;
+pub use error::{CellError, InvalidValue};
 pub use ik::{IkFailure, IkOptions};
 pub use layout::{
     Arrangement, Assembly, BuiltUpHeaders, Cell, Conveyor, Creep, Floor, Motion, OffsetX,

@@ -2,6 +2,7 @@
 //! (`rules/panels.dl` chooses the breaks). The conveyors cap the length further: the rules
 //! take the smaller of `max_length` and what the conveyors carry.
 
+use super::error::InvalidValue;
 use serde::Deserialize;
 
 /// The panel limits of a cell, SI units.
@@ -50,11 +51,13 @@ pub enum PanelMode {
 }
 
 impl PanelMode {
-    pub fn parse(text: &str) -> Result<PanelMode, String> {
+    pub fn parse(text: &str) -> Result<PanelMode, InvalidValue> {
         match text {
             "auto" => Ok(PanelMode::Auto),
             "off" => Ok(PanelMode::Off),
-            _ => Err(format!("expected `auto` or `off`, got `{text}`")),
+            _ => Err(InvalidValue(format!(
+                "expected `auto` or `off`, got `{text}`"
+            ))),
         }
     }
 

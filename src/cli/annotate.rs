@@ -2,12 +2,13 @@
 //! (property sets, the assembly sequence as tasks, the nails as fasteners) and optionally
 //! the simulation verdicts back into a copy of the model.
 
-use super::check::{ReasoningInputs, load_inputs, rule_base};
+use super::check::{ReasoningInputs, load_model_facts, rule_base};
 use super::{CmdResult, Failure, write_atomically};
 use framewright::bim::{AnnotateOptions, NailSize, annotate, element_verdicts};
+use framewright::frame::placement::reason_placing;
 use framewright::frame::plan::Plan;
-use framewright::frame::reason;
-use framewright::sim::{SimOptions, simulate};
+use framewright::pipeline::Run;
+use framewright::sim::{SimOptions, Simulation};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -41,22 +42,31 @@ pub struct AnnotateArgs {
 pub fn run(args: AnnotateArgs) -> CmdResult {
     let inputs = &args.inputs;
     let engine = rule_base(&inputs.rules_dir);
-    let (model, cell, facts) = load_inputs(&args.model, inputs, &engine)?;
-    let (plan, verdicts) = if args.simulate {
+    let (model, plan, verdicts) = if args.simulate {
+        inputs.tolerance_for_executor(
+            "leave out --simulate to annotate the plan with this tolerance",
+        )?;
+        let (model, cell, _) = load_model_facts(&args.model, inputs)?;
         let options = SimOptions {
             walls: args.walls.clone(),
             engine: engine.clone(),
-            ..SimOptions::default()
+            ..super::sim_defaults()?
         };
-        let sim = simulate(&model, &cell, &options)?;
+        let (sim, _) = Run::new(&model, &cell, &options)
+            .limits(super::rule_limits()?)
+            .simulate()?;
         let verdicts = element_verdicts(&sim);
         // The model's own walls, each with its panels (the simulation's plan has one wall per
         // panel, of pieces partly not in the model).
-        let reasoned = reason(&facts, &engine, false)?;
-        (Plan::from_reasoned(&model, &reasoned), Some(verdicts))
+        let Simulation {
+            plan, model_plan, ..
+        } = sim;
+        (model, model_plan.unwrap_or(plan), Some(verdicts))
     } else {
-        let reasoned = reason(&facts, &engine, false)?;
-        (Plan::from_reasoned(&model, &reasoned), None)
+        let (model, cell, facts) = load_model_facts(&args.model, inputs)?;
+        let (reasoned, _) = reason_placing(facts, &cell, &engine, None, &super::rule_limits()?)?;
+        let plan = Plan::from_reasoned(&model, &reasoned);
+        (model, plan, None)
     };
     let options = AnnotateOptions {
         date: args.date.clone(),

@@ -5,11 +5,12 @@
 use super::{CmdResult, Failure, print_stdout};
 use framewright::cell::{Cell, PanelMode};
 use framewright::frame::cell_facts::cell_facts;
-use framewright::frame::placement::add_placement_facts;
-use framewright::frame::{Facts, RuleEngine, model_facts, reason};
+use framewright::frame::placement::{add_placement_facts, reason_placing};
+use framewright::frame::{Facts, RuleEngine, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
-use framewright::sim::{SimOptions, simulate};
+use framewright::pipeline::Run;
+use framewright::sim::SimOptions;
 use framewright::user_rules::{Finding, Findings, UserRules, engine_for};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -117,7 +118,7 @@ pub fn load_model_facts(
             "--contact-tolerance {contact_tolerance_mm} mm is out of range; give 0 to 100 mm"
         )));
     }
-    let model = Model::open(model)?;
+    let model = super::open_model(model)?;
     let mut cell = load_cell(&inputs.cell, inputs.offset_x.as_deref())?;
     cell.panel_mode = inputs.panels;
     let contacts = ContactOptions {
@@ -172,20 +173,22 @@ pub fn run(args: CheckArgs) -> CmdResult {
         args.inputs
             .tolerance_for_executor("leave out --simulate to check the plan with this tolerance")?;
         // The executor reads the model and reasons itself.
-        let model = Model::open(&args.model)?;
+        let model = super::open_model(&args.model)?;
         let mut cell = load_cell(&args.inputs.cell, args.inputs.offset_x.as_deref())?;
         cell.panel_mode = args.inputs.panels;
         let options = SimOptions {
             walls: args.walls.clone(),
             engine: base.clone(),
-            ..SimOptions::default()
+            ..super::sim_defaults()?
         };
-        let sim = simulate(&model, &cell, &options)?;
+        let (sim, _) = Run::new(&model, &cell, &options)
+            .limits(super::rule_limits()?)
+            .simulate()?;
         let findings = user.evaluate(&sim.reasoned.relations)?;
         return report(&args, &model, &cell.name, &findings);
     }
-    let (model, cell, facts) = load_inputs(&args.model, &args.inputs, &base)?;
-    let reasoned = reason(&facts, &base, false)?;
+    let (model, cell, facts) = load_model_facts(&args.model, &args.inputs)?;
+    let (reasoned, _) = reason_placing(facts, &cell, &base, None, &super::rule_limits()?)?;
     let findings = user.evaluate(&reasoned.relations)?;
     report(&args, &model, &cell.name, &findings)
 }

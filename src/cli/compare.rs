@@ -7,7 +7,6 @@ use super::check::load_cell;
 use super::simulate::{Bars, simulate_through};
 use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::Need;
-use framewright::ifc::Model;
 use framewright::report::bid::{Bid, table_text};
 use framewright::report::bid_html::compare_page;
 use framewright::report::html::write_folder;
@@ -66,12 +65,12 @@ pub fn run(args: CompareArgs) -> CmdResult {
         cell.panel_mode = args.panels.panels;
         cells.push(cell);
     }
-    let model = Model::open(&args.model)?;
+    let model = super::open_model(&args.model)?;
     let name = super::diff::file_name(&args.model);
     let options = SimOptions {
         walls: args.walls,
         engine: super::check::rule_base(&args.rules_dir),
-        ..SimOptions::default()
+        ..super::sim_defaults()?
     };
     let cache = args.cache.open();
     let mut bids = Vec::new();

@@ -4,13 +4,13 @@
 
 use super::cache::CacheArgs;
 use super::{CmdResult, print_stdout};
-use framewright::cache::{Cache, cached_simulation};
+use framewright::cache::Cache;
 use framewright::cell::Cell;
 use framewright::diff::{Version, diff};
 use framewright::frame::plan::Plan;
 use framewright::ifc::Model;
+use framewright::pipeline::{FromCache, Run};
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, prepare};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -31,15 +31,6 @@ pub struct DiffArgs {
     pub cache: CacheArgs,
 }
 
-/// `simulate`'s default options (its default time step, computed the way it computes it, so
-/// the cache keys agree).
-pub fn simulate_defaults() -> SimOptions {
-    SimOptions {
-        dt: (1000.0 / 240.0) / 1000.0,
-        ..SimOptions::default()
-    }
-}
-
 /// A model's plan and, when the cache holds all its walls, its simulation report.
 pub fn plan_and_report(
     path: &Path,
@@ -47,16 +38,17 @@ pub fn plan_and_report(
     cell: &Cell,
     cache: Option<&Cache>,
 ) -> Result<(Plan, Option<SimReport>), super::Failure> {
-    let options = simulate_defaults();
-    if let Some(cache) = cache
-        && let Some(sim) = cached_simulation(model, &file_name(path), cell, &options, cache)?
-    {
-        let report = SimReport::new(&sim, options.dt);
-        return Ok((sim.plan, Some(report)));
-    }
+    let options = super::sim_defaults()?;
+    let name = file_name(path);
+    let run = Run::new(model, cell, &options).named(&name).cache(cache);
     // The plan a simulation of it would have: one wall per panel the cell builds.
-    let prepared = prepare(model, &file_name(path), cell, &options.engine)?;
-    Ok((prepared.plan, None))
+    Ok(match run.limits(super::rule_limits()?).from_cache()? {
+        FromCache::Whole(sim) => {
+            let report = SimReport::new(&sim, options.dt);
+            (sim.plan, Some(report))
+        }
+        FromCache::Missing(prepared) => (prepared.plan, None),
+    })
 }
 
 pub fn file_name(path: &Path) -> String {
@@ -70,8 +62,8 @@ pub fn run(args: DiffArgs) -> CmdResult {
     let mut cell = Cell::load(&args.cell)?;
     cell.panel_mode = args.panels.panels;
     let cache = args.cache.open();
-    let old = Model::open(&args.old)?;
-    let new = Model::open(&args.new)?;
+    let old = super::open_model(&args.old)?;
+    let new = super::open_model(&args.new)?;
     let (old_plan, old_report) = plan_and_report(&args.old, &old, &cell, cache.as_ref())?;
     let (new_plan, new_report) = plan_and_report(&args.new, &new, &cell, cache.as_ref())?;
     let (old_name, new_name) = (

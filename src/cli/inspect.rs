@@ -21,7 +21,7 @@ pub struct InspectArgs {
 pub fn run(args: InspectArgs) -> CmdResult {
     let options = ReadOptions {
         max_bytes: args.max_size.saturating_mul(1 << 20),
-        ..ReadOptions::from_env().map_err(|e| framewright::ifc::IfcError {
+        ..super::limits::read_options().map_err(|e| framewright::ifc::IfcError {
             path: args.model.clone(),
             kind: e.into(),
         })?

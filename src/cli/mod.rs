@@ -8,6 +8,7 @@ pub mod check;
 pub mod compare;
 pub mod diff;
 pub mod inspect;
+pub mod limits;
 pub mod plan;
 pub mod program;
 pub mod robot;
@@ -88,3 +89,5 @@ pub fn leave_to_exit<T>(value: T) {
 
 /// Every output file goes through the library's one atomic writer.
 pub use framewright::atomic::write_atomically;
+
+pub use limits::{open_model, rule_limits, sim_defaults};

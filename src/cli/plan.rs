@@ -7,9 +7,9 @@ use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::{ReasoningInputs, load_model_facts, rules_in_force};
 use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
 use framewright::cache::reason_plan_cached_with;
+use framewright::frame::RuleEngine;
 use framewright::frame::placement::reason_placed;
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, RuleLimits};
 use framewright::report::plan::PlanReport;
 use framewright::report::role_check::{RoleCheck, Truth};
 use std::path::PathBuf;
@@ -54,7 +54,7 @@ pub fn run(args: PlanArgs) -> CmdResult {
         RuleEngine::Compiled => args.cache.open(),
         _ => None,
     };
-    let limits = RuleLimits::from_env()?;
+    let limits = super::rule_limits()?;
     let (reasoned, counts, plan) = match &cache {
         Some(cache) => {
             // A first run stores its entries while the plan is built.

@@ -4,10 +4,10 @@
 
 use super::check::load_cell;
 use super::{CmdResult, leave_to_exit, print_stdout};
-use framewright::ifc::Model;
+use framewright::pipeline::Run;
 use framewright::program::{Language, programs, write_files};
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, simulate_with_progress};
+use framewright::sim::SimOptions;
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -40,16 +40,19 @@ pub struct ProgramArgs {
 }
 
 pub fn run(args: ProgramArgs) -> CmdResult {
-    let model = Model::open(&args.model)?;
+    let model = super::open_model(&args.model)?;
     let mut cell = load_cell(&args.cell, args.offset_x.as_deref())?;
     cell.panel_mode = args.panels.panels;
     let options = SimOptions {
         walls: args.walls,
         engine: super::check::rule_base(&args.rules_dir),
-        ..SimOptions::default()
+        ..super::sim_defaults()?
     };
     let name = super::diff::file_name(&args.model);
-    let sim = simulate_with_progress(&model, &name, &cell, &options, &|_, _, _| {})?;
+    let (sim, _) = Run::new(&model, &cell, &options)
+        .named(&name)
+        .limits(super::rule_limits()?)
+        .simulate()?;
     let report = SimReport::new(&sim, options.dt);
     // Every file is made before any is written: a bad `[io]` writes nothing.
     let walls = programs(&sim, &report, &cell, &name, args.format)?;

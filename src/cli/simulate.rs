@@ -4,13 +4,14 @@
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::{load_cell, rules_in_force};
 use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
-use framewright::cache::{Cache, CacheCounts, Need, Shard, simulate_cached_for, simulate_shard};
+use framewright::cache::{Cache, CacheCounts, Need, Shard};
 use framewright::cell::Cell;
 use framewright::ifc::Model;
+use framewright::pipeline::Run;
 use framewright::report::bid::Bid;
 use framewright::report::html::{ReportInput, write_report};
 use framewright::report::simulate::SimReport;
-use framewright::sim::{SimOptions, Simulation, Stepping, simulate_with_progress};
+use framewright::sim::{SimOptions, Simulation, Stepping};
 use framewright::user_rules::UserRules;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
@@ -47,7 +48,7 @@ pub struct SimulateArgs {
     #[arg(long = "rules", value_name = "FILE.dl")]
     pub rules: Vec<PathBuf>,
     /// Physics time step, milliseconds.
-    #[arg(long, value_name = "MS", default_value_t = 1000.0 / 240.0)]
+    #[arg(long, value_name = "MS", default_value_t = framewright::sim::DEFAULT_DT * 1000.0)]
     pub step_ms: f64,
     /// Fraction of the cell's programmed speeds to move at (0..1].
     #[arg(long, default_value_t = 1.0)]
@@ -74,7 +75,7 @@ pub struct SimulateArgs {
 }
 
 pub fn run(args: SimulateArgs) -> CmdResult {
-    let model = Model::open(&args.model)?;
+    let model = super::open_model(&args.model)?;
     let mut cell = load_cell(&args.cell, args.offset_x.as_deref())?;
     cell.panel_mode = args.panels.panels;
     let (engine, findings_files) = rules_in_force(&args.rules_dir, &args.rules)?;
@@ -84,6 +85,12 @@ pub fn run(args: SimulateArgs) -> CmdResult {
         speed: args.speed,
         stepping: args.stepping,
         engine,
+        max_seconds_per_wall: super::limits::max_sim_seconds_per_wall()?,
+    };
+    // Read before the run, so a bad bound is refused before hours of simulation.
+    let report_bound = match &args.report {
+        Some(_) => super::limits::max_report_bytes()?,
+        None => 0,
     };
     let user_rules = if findings_files.is_empty() {
         None
@@ -106,7 +113,11 @@ pub fn run(args: SimulateArgs) -> CmdResult {
                 "--shard needs a cache folder to put its walls in: give --cache DIR",
             ));
         };
-        let run = simulate_shard(&model, &name, &cell, &options, cache, shard, &progress)?;
+        let run = Run::new(&model, &cell, &options)
+            .named(&name)
+            .limits(super::rule_limits()?)
+            .progress(&progress)
+            .shard(cache, shard)?;
         bars.finish();
         warn_if_unwritable(Some(cache));
         return super::cache::print_shard(&run, args.json);
@@ -136,7 +147,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
             sim: &sim,
             report: &report,
         };
-        write_report(dir, &input).map_err(|e| {
+        write_report(dir, &input, report_bound).map_err(|e| {
             Failure::bad_input(format!("{}: cannot write the report: {e}", dir.display()))
         })?;
     }
@@ -160,17 +171,13 @@ pub(super) fn simulate_through(
     cache: Option<&Cache>,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<(Simulation, Option<CacheCounts>), Failure> {
-    Ok(match cache {
-        Some(cache) => {
-            let (sim, counts) =
-                simulate_cached_for(need, model, name, cell, options, cache, progress)?;
-            (sim, Some(counts))
-        }
-        None => (
-            simulate_with_progress(model, name, cell, options, progress)?,
-            None,
-        ),
-    })
+    let run = Run::new(model, cell, options)
+        .named(name)
+        .limits(super::rule_limits()?)
+        .cache(cache)
+        .need(need)
+        .progress(progress);
+    Ok(run.simulate()?)
 }
 
 /// One progress bar per wall on a terminal (stderr); nothing otherwise.

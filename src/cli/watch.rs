@@ -6,16 +6,16 @@
 //! last results and says why. Ctrl-C ends it.
 
 use super::cache::{CacheArgs, warn_if_unwritable};
-use super::diff::{file_name, simulate_defaults};
+use super::diff::file_name;
 use super::{CmdResult, Failure};
-use framewright::cache::{Cache, CacheCounts, Need, simulate_cached_for};
+use framewright::cache::{Cache, CacheCounts, Need};
 use framewright::cell::Cell;
 use framewright::diff::{ModelDiff, Version, diff};
 use framewright::frame::plan::Plan;
 use framewright::ifc::Model;
+use framewright::pipeline::Run;
 use framewright::report::html::{ReportInput, write_report};
 use framewright::report::simulate::SimReport;
-use framewright::sim::simulate;
 use framewright::user_rules::UserRules;
 use notify_debouncer_full::notify::event::ModifyKind;
 use notify_debouncer_full::notify::{EventKind, RecursiveMode};
@@ -103,7 +103,7 @@ struct Watch {
 pub fn run(args: WatchArgs) -> CmdResult {
     let mut cell = Cell::load(&args.cell)?;
     cell.panel_mode = args.panels.panels;
-    let mut options = simulate_defaults();
+    let mut options = super::sim_defaults()?;
     let (engine, findings_files) = super::check::rules_in_force(&None, &args.rules)?;
     options.engine = engine;
     let rules = if findings_files.is_empty() {
@@ -204,7 +204,7 @@ impl Watch {
             }
             self.seen = Some(hash);
         }
-        let model = match Model::open(&self.args.model) {
+        let model = match super::open_model(&self.args.model) {
             Ok(m) => m,
             Err(e) => {
                 let error = e.to_string();
@@ -277,7 +277,7 @@ impl Watch {
 
     /// Simulates (through the cache) and writes the outputs.
     fn simulate(&self, model: &Model) -> Result<(Plan, SimReport, Option<CacheCounts>), String> {
-        let options = simulate_defaults();
+        let options = super::sim_defaults().map_err(|e| e.message)?;
         let name = file_name(&self.args.model);
         // The report animates every wall: its pose traces must come back from the cache too.
         let need = if self.args.report.is_some() {
@@ -285,25 +285,14 @@ impl Watch {
         } else {
             Need::Records
         };
-        let (sim, counts) = match &self.cache {
-            Some(cache) => {
-                let (sim, counts) = simulate_cached_for(
-                    need,
-                    model,
-                    &name,
-                    &self.cell,
-                    &options,
-                    cache,
-                    &|_, _, _| {},
-                )
-                .map_err(|e| e.to_string())?;
-                (sim, Some(counts))
-            }
-            None => (
-                simulate(model, &self.cell, &options).map_err(|e| e.to_string())?,
-                None,
-            ),
-        };
+        let limits = super::rule_limits().map_err(|e| e.message)?;
+        let (sim, counts) = Run::new(model, &self.cell, &options)
+            .named(&name)
+            .limits(limits)
+            .cache(self.cache.as_ref())
+            .need(need)
+            .simulate()
+            .map_err(|e| e.to_string())?;
         warn_if_unwritable(self.cache.as_ref());
         let mut report = SimReport::new(&sim, options.dt);
         if let Some(rules) = &self.rules {
@@ -326,7 +315,8 @@ impl Watch {
                 sim: &sim,
                 report: &report,
             };
-            write_report(dir, &input)
+            let bound = super::limits::max_report_bytes().map_err(|e| e.message)?;
+            write_report(dir, &input, bound)
                 .map_err(|e| format!("{}: cannot write the report: {e}", dir.display()))?;
         }
         Ok((sim.plan, report, counts))

@@ -5,12 +5,11 @@
 
 use super::check::{ReasoningInputs, load_inputs, load_model_facts, rules_in_force};
 use super::{CmdResult, Failure, print_stdout};
-use framewright::cache::{Cache, wall_facts_cached};
+use framewright::cache::Cache;
 use framewright::explain::render::{render_answer, render_why, render_why_not};
 use framewright::explain::why::{
     Context, WhyError, element_walls_split, name_walls, resolve_element, why, why_not,
 };
-use framewright::frame::RuleLimits;
 use framewright::frame::containers::{containers_of, restrict_to_containers};
 use framewright::frame::panel::PanelOf;
 use framewright::frame::panel_why;
@@ -18,8 +17,8 @@ use framewright::frame::panelize::panels_by_piece;
 use framewright::frame::placement::{add_placement_facts, reason_placed};
 use framewright::frame::plan::Plan;
 use framewright::logic::compiled::Relations;
+use framewright::pipeline::{Run, prepare_facts, whole_facts};
 use framewright::sim::SimOptions;
-use framewright::sim::{prepare_facts, whole_facts};
 use serde::Serialize;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -122,7 +121,16 @@ fn simulate_walls(
         let whole = whole_facts(model, cell);
         let keep = containers_of(&whole, &pieces.iter().map(String::as_str).collect());
         let restrict = |f: framewright::frame::Facts| restrict_to_containers(&f, &keep);
-        let prepared = prepare_facts(model, "model", cell, &base, restrict(whole), &restrict)?;
+        let limits = super::rule_limits()?;
+        let prepared = prepare_facts(
+            model,
+            "model",
+            cell,
+            &base,
+            &limits,
+            restrict(whole),
+            &restrict,
+        )?;
         *facts = prepared.facts;
         prepared.panelized
     } else {
@@ -141,9 +149,12 @@ fn simulate_walls(
         let options = SimOptions {
             walls: vec![wall.clone()],
             engine: base.clone(),
-            ..SimOptions::default()
+            ..super::sim_defaults()?
         };
-        let (sim, counts) = wall_facts_cached(model, cell, &options, cache.as_ref())?;
+        let (sim, counts) = Run::new(model, cell, &options)
+            .limits(super::rule_limits()?)
+            .cache(cache.as_ref())
+            .wall_facts()?;
         facts.extend(sim);
         out.push(Simulated {
             wall,
@@ -270,11 +281,11 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     c.check_simulation()?;
     let (base, user_files) = rules_in_force(&c.inputs.rules_dir, &c.rules)?;
     if let Some(query) = panel_why::parse_break_query(&args.tuple) {
-        let (wall, u) = query.map_err(Failure::bad_input)?;
+        let (wall, u) = query.map_err(|e| Failure::bad_input(e.to_string()))?;
         let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
         let (plan, relations) = plan_of(facts, &cell, &base, &model)?;
         let answer = panel_why::why_no_break(&plan, &relations, &cell, &wall, u)
-            .map_err(Failure::bad_input)?;
+            .map_err(|e| Failure::bad_input(e.to_string()))?;
         return print_panel_answer(c, &args.model, &cell.name, &args.tuple, &answer);
     }
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs, &base)?;
@@ -307,7 +318,7 @@ fn plan_of(
     base: &framewright::frame::RuleEngine,
     model: &framewright::ifc::Model,
 ) -> Result<(Plan, Relations), Failure> {
-    let limits = RuleLimits::from_env()?;
+    let limits = super::rule_limits()?;
     let reasoned = reason_placed(facts, cell, base, Plan::RELATIONS, &limits)?;
     let plan = Plan::from_reasoned(model, &reasoned);
     Ok((plan, reasoned.relations))

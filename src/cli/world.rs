@@ -5,9 +5,7 @@
 use super::write_atomically;
 use super::{CmdResult, Failure, print_stdout};
 use framewright::cell::Cell;
-use framewright::frame::RuleEngine;
-use framewright::ifc::Model;
-use framewright::sim::prepare;
+use framewright::pipeline::Run;
 use framewright::world::{json, wbt};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -41,10 +39,12 @@ pub struct WorldArgs {
 pub fn run(args: WorldArgs) -> CmdResult {
     let mut cell = Cell::load(&args.cell)?;
     cell.panel_mode = args.panels.panels;
-    let model = Model::open(&args.model)?;
+    let model = super::open_model(&args.model)?;
     let name = super::diff::file_name(&args.model);
     // The scene of the panels the cell builds.
-    let scene = prepare(&model, &name, &cell, &RuleEngine::Compiled)?.scene;
+    let options = super::sim_defaults()?;
+    let run = Run::new(&model, &cell, &options).named(&name);
+    let scene = run.limits(super::rule_limits()?).prepare()?.scene;
     let bytes = match args.format {
         WorldFormat::Json => json::to_json(&scene).into_bytes(),
         WorldFormat::Wbt => wbt::to_wbt(&scene).into_bytes(),

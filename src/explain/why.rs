@@ -7,7 +7,8 @@
 
 use super::answer::answer;
 use super::report::Answer;
-pub use super::report::{ElementInfo, Sources, Verdict, WhyNotNode, WhyNotReport, WhyReport, walk};
+use super::report::walk;
+pub use super::report::{ElementInfo, Sources, Verdict, WhyNotNode, WhyNotReport, WhyReport};
 use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::panel::PanelOf;
 use crate::frame::{Facts, RuleEngine};

@@ -1,6 +1,7 @@
 //! Facts, origins, numbers and nail lists in the words the explanations print.
 
 use crate::logic::provenance::Explanation;
+use crate::logic::tokens::{Kind, map_tokens};
 use crate::logic::{Origin, Value};
 
 /// A fact as `relation(a, b, …)`, numbers shortened.
@@ -50,41 +51,12 @@ fn short_float(x: f64) -> String {
 
 /// Floats with more than 7 significant digits, outside quotes, shortened.
 pub fn shorten_numbers(text: &str) -> String {
-    let mut out = String::new();
-    let chars: Vec<char> = text.chars().collect();
-    let mut i = 0;
-    let mut in_str = false;
-    while i < chars.len() {
-        let c = chars[i];
-        if c == '"' && (i == 0 || chars[i - 1] != '\\') {
-            in_str = !in_str;
+    map_tokens(text, |kind, word, _| {
+        if kind != Kind::Number || !(word.contains('.') || word.contains('e')) {
+            return None;
         }
-        let starts_number = !in_str
-            && (c.is_ascii_digit()
-                || (c == '-' && chars.get(i + 1).is_some_and(char::is_ascii_digit)))
-            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_'));
-        if starts_number {
-            let mut j = i + 1;
-            while j < chars.len()
-                && (chars[j].is_ascii_digit()
-                    || chars[j] == '.'
-                    || chars[j] == 'e'
-                    || ((chars[j] == '-' || chars[j] == '+') && chars[j - 1] == 'e'))
-            {
-                j += 1;
-            }
-            let word: String = chars[i..j].iter().collect();
-            match word.parse::<f64>() {
-                Ok(x) if word.contains('.') || word.contains('e') => out.push_str(&short_float(x)),
-                _ => out.push_str(&word),
-            }
-            i = j;
-            continue;
-        }
-        out.push(c);
-        i += 1;
-    }
-    out
+        word.parse::<f64>().ok().map(short_float)
+    })
 }
 
 /// Nails listed compactly: `A -> B #1, #2; A -> C #1`.

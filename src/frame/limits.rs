@@ -1,11 +1,12 @@
 //! Bounds on what the built-in rule base may derive from a model, so a hostile or absurd
 //! model stops with an error naming the bound instead of filling memory: the number of
 //! walls, and the tuples the compiled rule base holds after running (counted over its
-//! declared relations, part by part, in all). Both can be raised by environment variables.
+//! declared relations, part by part, in all). The CLI raises both through environment
+//! variables (named in the errors).
 
-/// Environment variable raising the wall bound.
+/// Environment variable with which the CLI raises the wall bound.
 pub const ENV_MAX_WALLS: &str = "FRAMEWRIGHT_MAX_WALLS";
-/// Environment variable raising the rule tuple bound.
+/// Environment variable with which the CLI raises the rule tuple bound.
 pub const ENV_MAX_RULE_TUPLES: &str = "FRAMEWRIGHT_MAX_RULE_TUPLES";
 
 /// Default wall bound: a 50,000-member building has about 1,600 walls.
@@ -57,23 +58,6 @@ pub enum LimitError {
 }
 
 impl RuleLimits {
-    /// The defaults, raised or lowered by the environment variables.
-    pub fn from_env() -> Result<RuleLimits, LimitError> {
-        fn var(variable: &'static str, default: u64) -> Result<u64, LimitError> {
-            match std::env::var(variable) {
-                Ok(value) => value
-                    .trim()
-                    .parse()
-                    .map_err(|_| LimitError::BadValue { variable, value }),
-                Err(_) => Ok(default),
-            }
-        }
-        Ok(RuleLimits {
-            max_walls: var(ENV_MAX_WALLS, DEFAULT_MAX_WALLS)?,
-            max_rule_tuples: var(ENV_MAX_RULE_TUPLES, DEFAULT_MAX_RULE_TUPLES)?,
-        })
-    }
-
     pub fn check_walls(&self, found: u64) -> Result<(), LimitError> {
         if found > self.max_walls {
             return Err(LimitError::Walls {

@@ -14,6 +14,7 @@ pub mod partition;
 pub mod placement;
 pub mod plan;
 mod plan_build;
+pub mod rows;
 pub mod rule_reads;
 
 use crate::logic::compiled::{self, Relations};
@@ -33,10 +34,15 @@ pub enum FrameError {
     Logic(#[from] LogicError),
     #[error("the compiled rule base failed: {0}")]
     Compiled(String),
+    /// A runtime error of the compiled rule base (same text as `Compiled`).
+    #[error("the compiled rule base failed: {0}")]
+    CompiledRun(compiled::CompiledError),
     #[error("{}: cannot read the rules directory: {message}", path.display())]
     RulesDir { path: PathBuf, message: String },
     #[error(transparent)]
     Limit(#[from] limits::LimitError),
+    #[error(transparent)]
+    Row(#[from] rows::RowError),
 }
 
 /// Which engine evaluates the rule base.
@@ -108,18 +114,18 @@ pub fn extended_program(files: &[PathBuf]) -> Result<Program, FrameError> {
     Ok(loader.finish()?)
 }
 
-/// Runs the rule base over the facts.
+/// Runs the rule base over the facts, within the default bounds (`reason_within` takes others).
 pub fn reason(
     facts: &Facts,
     engine: &RuleEngine,
     provenance: bool,
 ) -> Result<Reasoned, FrameError> {
-    reason_within(facts, engine, provenance, None, &RuleLimits::from_env()?)
+    reason_within(facts, engine, provenance, None, &RuleLimits::default())
 }
 
 /// Runs the rule base over the facts for a caller that reads only the named relations (the
 /// others may be missing from the result): the compiled engine then turns only those into
-/// `Value` tuples. `plan` reads `Plan::RELATIONS`.
+/// `Value` tuples. `plan` reads `Plan::RELATIONS`. Within the default bounds.
 pub fn reason_selected(
     facts: &Facts,
     engine: &RuleEngine,
@@ -130,7 +136,7 @@ pub fn reason_selected(
         engine,
         false,
         Some(relations),
-        &RuleLimits::from_env()?,
+        &RuleLimits::default(),
     )
 }
 
@@ -142,9 +148,37 @@ pub fn reason_within(
     selected: Option<&[&str]>,
     limits: &RuleLimits,
 ) -> Result<Reasoned, FrameError> {
+    count_run(selected.is_some());
     let reasoned = reason_unchecked(facts, engine, provenance, selected, limits)?;
     limits.check_walls(reasoned.get("wall").len() as u64)?;
     Ok(reasoned)
+}
+
+static WHOLE_RUNS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+static CUT_RUNS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many times this process has run the rule base over a model's facts: what a test reads
+/// to show that a command reasons a model as often as it says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RuleBaseRuns {
+    /// Runs that derive every relation.
+    pub whole: u64,
+    /// Runs cut down to the relations a caller reads (the placement search's first pass,
+    /// `plan`); a placed run, whose search sits between its two passes, counts once.
+    pub cut: u64,
+}
+
+pub fn rule_base_runs() -> RuleBaseRuns {
+    use std::sync::atomic::Ordering::Relaxed;
+    RuleBaseRuns {
+        whole: WHOLE_RUNS.load(Relaxed),
+        cut: CUT_RUNS.load(Relaxed),
+    }
+}
+
+fn count_run(cut: bool) {
+    let runs = if cut { &CUT_RUNS } else { &WHOLE_RUNS };
+    runs.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
 }
 
 fn reason_unchecked(
@@ -234,7 +268,7 @@ pub(crate) fn reason_compiled_placing(
             let (relations, tuples) = match (&wanted, place) {
                 (Some(w), Some(place)) if compiled::builtin::handles(&part, w) => {
                     let r = compiled::builtin::run_placed(&part, placement::FIRST_PASS, w, place)
-                        .map_err(FrameError::Compiled)?;
+                        .map_err(FrameError::CompiledRun)?;
                     (r.relations, r.tuples)
                 }
                 (_, Some(_)) => {
@@ -244,12 +278,12 @@ pub(crate) fn reason_compiled_placing(
                     ));
                 }
                 (Some(w), None) if compiled::builtin::handles(&part, w) => {
-                    let r =
-                        compiled::builtin::run_selected(&part, w).map_err(FrameError::Compiled)?;
+                    let r = compiled::builtin::run_selected(&part, w)
+                        .map_err(FrameError::CompiledRun)?;
                     (r.relations, r.tuples)
                 }
                 _ => {
-                    let r = run(&part).map_err(FrameError::Compiled)?;
+                    let r = run(&part).map_err(FrameError::CompiledRun)?;
                     let n = r.values().map(|t| t.len() as u64).sum();
                     (r, n)
                 }

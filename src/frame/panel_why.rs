@@ -9,6 +9,22 @@ use crate::cell::{Cell, PanelLimits, PanelMode};
 use crate::logic::compiled::Relations;
 use serde::Serialize;
 
+/// A `why-not panel_break(...)` query that cannot be answered.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PanelWhyError {
+    #[error(
+        "`{tuple}`: write panel_break(WALL, U), e.g. panel_break(W1, 7.0), with U in m from the wall's start"
+    )]
+    Form { tuple: String },
+    #[error("`{tuple}`: `{u}` is not a position in m")]
+    Position { tuple: String, u: String },
+    /// `known`: the first walls of the plan, comma-separated.
+    #[error("no wall `{wall}` in the plan (walls: {known}, …)")]
+    UnknownWall { wall: String, known: String },
+    #[error("the rule base derives no panel limits (a rules directory without panels.dl)")]
+    NoPanelLimits,
+}
+
 /// An answer: what was asked about and the explanation, one statement per line.
 #[derive(Debug, Serialize)]
 pub struct PanelWhy {
@@ -279,15 +295,15 @@ fn panel_lines(
 }
 
 /// `panel_break(WALL, U)`: the wall id and u (m) of a why-not query, if it has that form.
-pub fn parse_break_query(tuple: &str) -> Option<Result<(String, f64), String>> {
+pub fn parse_break_query(tuple: &str) -> Option<Result<(String, f64), PanelWhyError>> {
     let inner = tuple
         .trim()
         .strip_prefix("panel_break(")?
         .strip_suffix(')')?;
     let Some((wall, u)) = inner.rsplit_once(',') else {
-        return Some(Err(format!(
-            "`{tuple}`: write panel_break(WALL, U), e.g. panel_break(W1, 7.0), with U in m from the wall's start"
-        )));
+        return Some(Err(PanelWhyError::Form {
+            tuple: tuple.to_string(),
+        }));
     };
     let wall = wall.trim().trim_matches('"').to_string();
     Some(
@@ -296,7 +312,10 @@ pub fn parse_break_query(tuple: &str) -> Option<Result<(String, f64), String>> {
             .ok()
             .filter(|u| u.is_finite())
             .map(|u| (wall, u))
-            .ok_or_else(|| format!("`{tuple}`: `{}` is not a position in m", u.trim())),
+            .ok_or_else(|| PanelWhyError::Position {
+                tuple: tuple.to_string(),
+                u: u.trim().to_string(),
+            }),
     )
 }
 
@@ -307,21 +326,19 @@ pub fn why_no_break(
     cell: &Cell,
     wall_id: &str,
     u: f64,
-) -> Result<PanelWhy, String> {
+) -> Result<PanelWhy, PanelWhyError> {
     let wall = plan
         .walls
         .iter()
         .find(|w| w.id == wall_id || w.name == wall_id)
         .ok_or_else(|| {
             let ids: Vec<&str> = plan.walls.iter().take(8).map(|w| w.id.as_str()).collect();
-            format!(
-                "no wall `{wall_id}` in the plan (walls: {}, …)",
-                ids.join(", ")
-            )
+            PanelWhyError::UnknownWall {
+                wall: wall_id.to_string(),
+                known: ids.join(", "),
+            }
         })?;
-    let limits = plan
-        .panel_limits
-        .ok_or("the rule base derives no panel limits (a rules directory without panels.dl)")?;
+    let limits = plan.panel_limits.ok_or(PanelWhyError::NoPanelLimits)?;
     let subject = format!("panel_break({}, {u})", wall.id);
     let mut lines = vec![];
     if let Some(b) = wall

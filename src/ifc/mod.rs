@@ -11,6 +11,7 @@
 
 mod context;
 mod error;
+pub mod guid;
 pub mod limits;
 mod placement;
 mod products;
@@ -48,14 +49,9 @@ pub struct Model {
 }
 
 impl Model {
-    /// Reads a model with the default limits, raised or lowered by the
-    /// `FRAMEWRIGHT_MAX_IFC_*` environment variables (see `ReadOptions::from_env`).
+    /// Reads a model with the reader's default limits (`open_with` takes others).
     pub fn open(path: impl AsRef<Path>) -> Result<Model, IfcError> {
-        let options = ReadOptions::from_env().map_err(|e| IfcError {
-            path: path.as_ref().to_path_buf(),
-            kind: e.into(),
-        })?;
-        Self::open_with(path, &options)
+        Self::open_with(path, &ReadOptions::default())
     }
 
     pub fn open_with(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Model, IfcError> {

@@ -1,6 +1,7 @@
 //! Errors of the rule engines (library side; the CLI maps them to exit 2).
 
 use super::front::Diagnostics;
+use super::front::ast::BaseTy;
 use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
@@ -44,4 +45,43 @@ pub enum LogicError {
     /// Misuse from Rust code or the command line (unknown relation, wrong arity, ...).
     #[error("{0}")]
     Usage(String),
+}
+
+/// A runtime error of an operation in a rule (division by zero, bad `to_number`, ...): what
+/// went wrong; the engine that ran the rule names it (`LogicError::Runtime`, `CompiledError`).
+#[derive(Debug, Clone, Default, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct EvalError(pub String);
+
+impl EvalError {
+    pub fn new(message: impl Into<String>) -> Self {
+        EvalError(message.into())
+    }
+}
+
+/// The first runtime error of a compiled rule program (`logic::compiled`), in the rule it
+/// happened in; the run's results are discarded.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("runtime error in {rule}: {message}")]
+pub struct CompiledError {
+    pub rule: String,
+    pub message: EvalError,
+}
+
+/// A field of a `.facts` file (or a queried tuple) that is not a value of its type
+/// (`Value::parse`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ParseValueError {
+    #[error("`{0}` is not a number")]
+    Number(String),
+    #[error("`{0}` is not an unsigned number")]
+    Unsigned(String),
+    #[error("`{0}` is not a float")]
+    Float(String),
+    /// A vector, pose or box not written `[...]`.
+    #[error("expected `[...]` with {n} numbers for a {ty}, found `{text}`")]
+    Brackets { n: usize, ty: BaseTy, text: String },
+    /// A vector, pose or box with the wrong count of numbers, or one that is not a number.
+    #[error("expected {n} comma-separated numbers for a {ty}, found `{text}`")]
+    Numbers { n: usize, ty: BaseTy, text: String },
 }

@@ -53,7 +53,7 @@ fn file_for(
         Some(f) => f.clone(),
         None => format!("{rel}.{}", direction.ext()),
     };
-    let refuse = |why: String| {
+    let refuse = |why: confine::Refusal| {
         LogicError::Confined(format!(
             "{}: `{}` of `{rel}`: file name {name:?} {why}; it must stay in {}\n  = hint: give a \
              plain relative name (no `..`, no absolute path, no symbolic link out), or choose the \

@@ -16,6 +16,7 @@ pub mod io;
 pub mod io_symbols;
 pub mod ops;
 pub mod provenance;
+pub mod tokens;
 pub mod value;
 
 pub use error::LogicError;

@@ -2,22 +2,23 @@
 //! the interpreter and the compiled engine so both compute the same values.
 //! `Err` carries the message of a runtime error (the caller names the rule).
 
+use super::error::EvalError;
 use super::value::{F64, Sym, format_float};
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
-pub type OpResult<T> = Result<T, String>;
+pub type OpResult<T> = Result<T, EvalError>;
 
 pub fn div_i64(a: i64, b: i64) -> OpResult<i64> {
     if b == 0 {
-        return Err(format!("division by zero ({a} / 0)"));
+        return Err(EvalError(format!("division by zero ({a} / 0)")));
     }
     Ok(a.wrapping_div(b))
 }
 pub fn rem_i64(a: i64, b: i64) -> OpResult<i64> {
     if b == 0 {
-        return Err(format!("division by zero ({a} % 0)"));
+        return Err(EvalError(format!("division by zero ({a} % 0)")));
     }
     Ok(a.wrapping_rem(b))
 }
@@ -45,13 +46,13 @@ fn pow_wrapping(mut base: u64, mut e: u64) -> u64 {
 }
 pub fn div_u64(a: u64, b: u64) -> OpResult<u64> {
     if b == 0 {
-        return Err(format!("division by zero ({a} / 0)"));
+        return Err(EvalError(format!("division by zero ({a} / 0)")));
     }
     Ok(a / b)
 }
 pub fn rem_u64(a: u64, b: u64) -> OpResult<u64> {
     if b == 0 {
-        return Err(format!("division by zero ({a} % 0)"));
+        return Err(EvalError(format!("division by zero ({a} % 0)")));
     }
     Ok(a % b)
 }
@@ -64,10 +65,10 @@ pub const MAX_SYMBOL_BYTES: usize = 1 << 20;
 pub fn cat_bounded(parts: &[&str]) -> OpResult<Sym> {
     let len: usize = parts.iter().map(|p| p.len()).sum();
     if len > MAX_SYMBOL_BYTES {
-        return Err(format!(
+        return Err(EvalError(format!(
             "cat would make a symbol of {len} bytes, more than the limit of {MAX_SYMBOL_BYTES} bytes \
              (a rule that concatenates its own output grows without end: bound it, e.g. `strlen(s) < 100`)"
-        ));
+        )));
     }
     Ok(cat(parts))
 }
@@ -81,15 +82,17 @@ pub fn strlen(s: &str) -> i64 {
 /// Bytes `[start, start+len)` (len clipped at the end of the string).
 pub fn substr(s: &str, start: i64, len: i64) -> OpResult<Sym> {
     if start < 0 || start as usize > s.len() || len < 0 {
-        return Err(format!(
+        return Err(EvalError(format!(
             "substr({s:?}, {start}, {len}): start or length out of range (string has {} bytes)",
             s.len()
-        ));
+        )));
     }
     let end = (start as usize).saturating_add(len as usize).min(s.len());
-    s.get(start as usize..end)
-        .map(Sym::from)
-        .ok_or_else(|| format!("substr({s:?}, {start}, {len}) would split a UTF-8 character"))
+    s.get(start as usize..end).map(Sym::from).ok_or_else(|| {
+        EvalError(format!(
+            "substr({s:?}, {start}, {len}) would split a UTF-8 character"
+        ))
+    })
 }
 /// Ordinals handed out by `ord`, in order of first use.
 pub type OrdTable = HashMap<String, i64>;
@@ -136,18 +139,18 @@ pub fn ord(s: &str) -> i64 {
 pub fn to_number(s: &str) -> OpResult<i64> {
     s.trim()
         .parse()
-        .map_err(|_| format!("to_number({s:?}): not a number"))
+        .map_err(|_| EvalError(format!("to_number({s:?}): not a number")))
 }
 pub fn to_unsigned(s: &str) -> OpResult<u64> {
     s.trim()
         .parse()
-        .map_err(|_| format!("to_unsigned({s:?}): not an unsigned number"))
+        .map_err(|_| EvalError(format!("to_unsigned({s:?}): not an unsigned number")))
 }
 pub fn to_float(s: &str) -> OpResult<F64> {
     s.trim()
         .parse()
         .map(F64)
-        .map_err(|_| format!("to_float({s:?}): not a float"))
+        .map_err(|_| EvalError(format!("to_float({s:?}): not a float")))
 }
 pub fn i64_to_string(n: i64) -> Sym {
     Sym::from(n.to_string().as_str())
@@ -179,15 +182,12 @@ pub fn regex_match(pattern: &str, text: &str) -> OpResult<bool> {
     thread_local! {
         /// Compiled patterns, or why one is not a regular expression. Only a cache: the
         /// warning is recorded on every use, so a run warns whatever ran before it.
-        static CACHE: RefCell<HashMap<String, Result<regex::Regex, String>>> = RefCell::new(HashMap::new());
+        static CACHE: RefCell<HashMap<String, Result<regex::Regex, regex::Error>>> = RefCell::new(HashMap::new());
     }
     CACHE.with(|c| {
         let mut c = c.borrow_mut();
         if !c.contains_key(pattern) {
-            let re = regex::Regex::new(&format!("^(?:{pattern})$")).map_err(|e| {
-                let first = e.to_string().lines().last().unwrap_or_default().to_string();
-                format!("wrong pattern provided for match({pattern:?}, ...): {first}; it matches nothing")
-            });
+            let re = regex::Regex::new(&format!("^(?:{pattern})$"));
             if c.len() > 1024 {
                 c.clear();
             }
@@ -195,8 +195,12 @@ pub fn regex_match(pattern: &str, text: &str) -> OpResult<bool> {
         }
         match &c[pattern] {
             Ok(re) => Ok(re.is_match(text)),
-            Err(warning) => {
-                WARNINGS.with(|w| w.borrow_mut().insert(warning.clone()));
+            Err(e) => {
+                let first = e.to_string().lines().last().unwrap_or_default().to_string();
+                let warning = format!(
+                    "wrong pattern provided for match({pattern:?}, ...): {first}; it matches nothing"
+                );
+                WARNINGS.with(|w| w.borrow_mut().insert(warning));
                 Ok(false)
             }
         }

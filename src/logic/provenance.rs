@@ -470,46 +470,18 @@ fn instantiate(lit: &Literal, cr: &CRule, env: &[Value], bound: Option<&[bool]>)
     };
     let text = lit.to_string();
     let mut vars: Vec<(String, String)> = Vec::new();
-    for (s, n) in cr.slot_names.iter().enumerate() {
-        let _ = s;
+    for n in &cr.slot_names {
         if let Some(v) = value_of(n) {
             vars.push((n.clone(), v));
         }
     }
-    // Replace whole-word variable names.
-    let mut out = String::new();
-    let chars: Vec<char> = text.chars().collect();
-    let mut i = 0;
-    let mut in_str = false;
-    while i < chars.len() {
-        let c = chars[i];
-        if c == '"' {
-            in_str = !in_str;
+    // Replace whole-word variable names (not a functor's or a relation's name before `(`).
+    super::tokens::map_tokens(&text, |kind, word, next| {
+        if kind != super::tokens::Kind::Ident || next == Some('(') {
+            return None;
         }
-        if !in_str
-            && (c.is_alphabetic() || c == '_')
-            && (i == 0
-                || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == '@'))
-        {
-            let mut j = i;
-            while j < chars.len()
-                && (chars[j].is_alphanumeric() || chars[j] == '_' || chars[j] == '?')
-            {
-                j += 1;
-            }
-            let word: String = chars[i..j].iter().collect();
-            let is_call = chars.get(j) == Some(&'(');
-            match vars.iter().find(|(n, _)| *n == word) {
-                Some((_, v)) if !is_call => out.push_str(v),
-                _ => out.push_str(&word),
-            }
-            i = j;
-            continue;
-        }
-        out.push(c);
-        i += 1;
-    }
-    out
+        vars.iter().find(|(n, _)| n == word).map(|(_, v)| v.clone())
+    })
 }
 
 fn show_tuple(t: &[Value]) -> String {
@@ -662,7 +634,7 @@ pub fn parse_query(
         } else {
             f
         };
-        vals.push(Value::parse(a.ty, f).map_err(|m| bad(&m))?);
+        vals.push(Value::parse(a.ty, f).map_err(|m| bad(&m.to_string()))?);
     }
     Ok((name.to_string(), vals))
 }

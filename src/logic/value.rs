@@ -14,6 +14,7 @@ use std::fmt;
 use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
+use super::error::ParseValueError;
 pub use super::front::ast::BaseTy;
 
 /// A symbol: interned immutable text. Equal symbols share one address, so equality is a
@@ -302,36 +303,40 @@ impl Value {
     }
 
     /// Parse a field of a `.facts` file as a value of type `ty`.
-    pub fn parse(ty: BaseTy, text: &str) -> Result<Value, String> {
+    pub fn parse(ty: BaseTy, text: &str) -> Result<Value, ParseValueError> {
         let t = text.trim();
-        let floats = |n: usize| -> Result<Vec<f64>, String> {
+        let floats = |n: usize| -> Result<Vec<f64>, ParseValueError> {
             let inner = t
                 .strip_prefix('[')
                 .and_then(|s| s.strip_suffix(']'))
-                .ok_or_else(|| {
-                    format!("expected `[...]` with {n} numbers for a {ty}, found `{t}`")
+                .ok_or_else(|| ParseValueError::Brackets {
+                    n,
+                    ty,
+                    text: t.to_string(),
                 })?;
             let v: Result<Vec<f64>, _> =
                 inner.split(',').map(|x| x.trim().parse::<f64>()).collect();
             match v {
                 Ok(v) if v.len() == n => Ok(v),
-                _ => Err(format!(
-                    "expected {n} comma-separated numbers for a {ty}, found `{t}`"
-                )),
+                _ => Err(ParseValueError::Numbers {
+                    n,
+                    ty,
+                    text: t.to_string(),
+                }),
             }
         };
         Ok(match ty {
             BaseTy::Number => {
-                Value::Number(parse_int(t).ok_or_else(|| format!("`{t}` is not a number"))?)
+                Value::Number(parse_int(t).ok_or_else(|| ParseValueError::Number(t.to_string()))?)
             }
             BaseTy::Unsigned => Value::Unsigned(
                 parse_int(t)
                     .and_then(|v| u64::try_from(v).ok())
-                    .ok_or_else(|| format!("`{t}` is not an unsigned number"))?,
+                    .ok_or_else(|| ParseValueError::Unsigned(t.to_string()))?,
             ),
             BaseTy::Float => Value::float(
                 t.parse::<f64>()
-                    .map_err(|_| format!("`{t}` is not a float"))?,
+                    .map_err(|_| ParseValueError::Float(t.to_string()))?,
             ),
             BaseTy::Symbol => Value::sym(text),
             BaseTy::Vec3 => {

@@ -8,7 +8,7 @@
 use super::conf::{kuka_status, kuka_turn, posture};
 use super::routine::{Instr, SignalRole};
 use super::text::{comment_text, num};
-use super::{ProgramFile, WallProgram};
+use super::{ProgramError, ProgramFile, WallProgram};
 use crate::cell::io::Signal;
 use nalgebra::Isometry3;
 use std::fmt::Write;
@@ -24,8 +24,9 @@ pub fn default_signal(role: SignalRole) -> i64 {
     }
 }
 
-/// The `.src` and `.dat` of one wall. Err: an `[io]` key holding a RAPID name.
-pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
+/// The `.src` and `.dat` of one wall. Err (`ProgramError::Signal`): an `[io]` key holding a
+/// RAPID name.
+pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], ProgramError> {
     let WallProgram {
         routine,
         cell,
@@ -35,11 +36,11 @@ pub fn files(program: &WallProgram) -> Result<[ProgramFile; 2], String> {
     let signals = program.signals(|role, given| match given {
         None => Ok(default_signal(role)),
         Some(Signal::Number(n)) => Ok(*n),
-        Some(Signal::Name(name)) => Err(format!(
+        Some(Signal::Name(name)) => Err(ProgramError::Signal(format!(
             "[io] {} = {name:?} is a RAPID signal name; a KRL program needs a signal number (e.g. {})",
             role.key(),
             default_signal(role)
-        )),
+        ))),
     })?;
     let tools = program.tool_names("TOOL");
     // KUKA tool frames and loads are given in the flange frame (x out of the flange); the

@@ -87,8 +87,8 @@ impl WallProgram<'_> {
     /// language's signal by `pick` (Err: the other language's kind).
     pub fn signals<T>(
         &self,
-        pick: impl Fn(routine::SignalRole, Option<&crate::cell::io::Signal>) -> Result<T, String>,
-    ) -> Result<BTreeMap<routine::SignalRole, T>, String> {
+        pick: impl Fn(routine::SignalRole, Option<&crate::cell::io::Signal>) -> Result<T, ProgramError>,
+    ) -> Result<BTreeMap<routine::SignalRole, T>, ProgramError> {
         let io = &self.cell.io;
         self.routine
             .signals
@@ -196,8 +196,8 @@ pub fn programs(
             ],
         };
         let files = match language {
-            Language::Rapid => vec![rapid::module(&program).map_err(ProgramError::Signal)?],
-            Language::Krl => krl::files(&program).map_err(ProgramError::Signal)?.to_vec(),
+            Language::Rapid => vec![rapid::module(&program)?],
+            Language::Krl => krl::files(&program)?.to_vec(),
         };
         out.push(WallFiles {
             files,

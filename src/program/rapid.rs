@@ -6,7 +6,7 @@
 use super::conf::{abb_confdata, posture};
 use super::routine::{Instr, Routine, SignalRole};
 use super::text::{comment_text, num};
-use super::{ProgramFile, WallProgram};
+use super::{ProgramError, ProgramFile, WallProgram};
 use crate::cell::io::Signal;
 use nalgebra::{Isometry3, UnitQuaternion};
 use std::fmt::Write;
@@ -25,8 +25,9 @@ pub fn default_signal(role: SignalRole) -> &'static str {
     }
 }
 
-/// The module of one wall. Err: an `[io]` key holding a KRL number, not a RAPID name.
-pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
+/// The module of one wall. Err (`ProgramError::Signal`): an `[io]` key holding a KRL number,
+/// not a RAPID name.
+pub fn module(program: &WallProgram) -> Result<ProgramFile, ProgramError> {
     let WallProgram {
         routine,
         cell,
@@ -36,11 +37,11 @@ pub fn module(program: &WallProgram) -> Result<ProgramFile, String> {
     let signals = program.signals(|role, given| match given {
         None => Ok(default_signal(role).to_string()),
         Some(Signal::Name(name)) => Ok(name.clone()),
-        Some(Signal::Number(n)) => Err(format!(
+        Some(Signal::Number(n)) => Err(ProgramError::Signal(format!(
             "[io] {} = {n} is a KRL signal number; a RAPID program needs a signal name (e.g. {:?})",
             role.key(),
             default_signal(role)
-        )),
+        ))),
     })?;
     let tools = program.tool_names("tool");
     let speeds = line_speeds(routine);

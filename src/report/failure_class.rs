@@ -8,7 +8,7 @@
 
 use crate::cell::{IkFailure, Robot};
 use crate::sim::WallRecord;
-use crate::sim::record::{NailOutcome, RefusalKind};
+use crate::sim::record::{NailOutcome, Op, RefusalKind};
 use serde::Serialize;
 
 /// A kind of failure, for counting.
@@ -151,7 +151,7 @@ pub fn piece_class(record: &WallRecord, piece: &str, robot: &Robot) -> FailureCl
     let ik = record
         .ik
         .iter()
-        .filter(|r| r.piece == piece && r.op != "nail")
+        .filter(|r| r.piece == piece && r.op != Op::Nail)
         .find_map(|r| r.result.as_ref().err());
     if let Some(failure) = ik {
         return ik_class(failure, robot);
@@ -159,7 +159,7 @@ pub fn piece_class(record: &WallRecord, piece: &str, robot: &Robot) -> FailureCl
     if let Some(c) = record
         .contacts
         .iter()
-        .find(|c| c.piece == piece && c.op != "nail")
+        .find(|c| c.piece == piece && c.op != Op::Nail)
     {
         return collision(&c.body_a, &c.body_b, robot);
     }

@@ -33,23 +33,11 @@ pub struct ReportInput<'a> {
     pub report: &'a SimReport,
 }
 
-/// The environment variable that bounds a report's size in bytes (all its files are built in
+/// The environment variable with which the CLI bounds a report's size in bytes (all its files are built in
 /// memory before the folder is swapped in, so this bounds the memory the report takes too).
 pub const ENV_MAX_REPORT_BYTES: &str = "FRAMEWRIGHT_MAX_REPORT_BYTES";
 /// The default bound: 2 GiB (a 150-wall building's report is about 200 MB).
 pub const DEFAULT_MAX_REPORT_BYTES: u64 = 2 << 30;
-
-/// The report size bound in force: `FRAMEWRIGHT_MAX_REPORT_BYTES` or the default.
-pub fn max_report_bytes() -> std::io::Result<u64> {
-    match std::env::var(ENV_MAX_REPORT_BYTES) {
-        Ok(v) => v.trim().parse::<u64>().map_err(|_| {
-            std::io::Error::other(format!(
-                "{ENV_MAX_REPORT_BYTES}={v:?} is not a whole number of bytes"
-            ))
-        }),
-        Err(_) => Ok(DEFAULT_MAX_REPORT_BYTES),
-    }
-}
 
 /// The files of a report, by name in the report folder, in writing order.
 pub fn report_files(input: &ReportInput) -> Vec<(String, Vec<u8>)> {
@@ -396,9 +384,10 @@ fn remove_dead_staging(parent: &Path, name: &str) {
 }
 
 /// Writes the report's files into `dir`: built in a fresh temporary folder beside it, then
-/// swapped into place (an existing `dir` is replaced only once the new one is complete).
-pub fn write_report(dir: &Path, input: &ReportInput) -> std::io::Result<()> {
-    let files = report_files_within(input, max_report_bytes()?)?;
+/// swapped into place (an existing `dir` is replaced only once the new one is complete). Its
+/// files may add up to `max_bytes` (`DEFAULT_MAX_REPORT_BYTES` by default).
+pub fn write_report(dir: &Path, input: &ReportInput, max_bytes: u64) -> std::io::Result<()> {
+    let files = report_files_within(input, max_bytes)?;
     write_folder(dir, &files)
 }
 

@@ -1,6 +1,6 @@
 //! The `inspect` report: what the reader found in a model.
 
-use super::{round_m, round_point};
+use super::member::{MemberId, MemberShape};
 use crate::ifc::{LengthUnit, Model, Warning};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -14,26 +14,20 @@ pub struct InspectReport<'m> {
     pub length_unit: &'m LengthUnit,
     pub originating_system: &'m str,
     pub entity_count: usize,
-    pub members: Vec<MemberRow<'m>>,
+    pub members: Vec<ReadMember<'m>>,
     pub warnings: &'m [Warning],
 }
 
+/// A piece as the reader found it.
 #[derive(Debug, Serialize)]
-pub struct MemberRow<'m> {
-    pub id: &'m str,
-    pub entity: u64,
-    pub global_id: &'m str,
-    pub piece: Option<usize>,
-    pub name: Option<&'m str>,
-    pub ifc_type: &'m str,
+pub struct ReadMember<'m> {
+    #[serde(flatten)]
+    pub member: MemberId<'m>,
     pub predefined_type: Option<&'m str>,
     pub parent_global_id: Option<&'m str>,
     pub material: Option<&'m str>,
-    pub axis_start: [f64; 3],
-    pub axis_end: [f64; 3],
-    pub width: f64,
-    pub thickness: f64,
-    pub length: f64,
+    #[serde(flatten)]
+    pub shape: MemberShape,
     pub volume: f64,
 }
 
@@ -44,24 +38,15 @@ impl<'m> InspectReport<'m> {
             .iter()
             .map(|p| {
                 let (start, end) = p.axis();
-                MemberRow {
-                    id: &p.id,
-                    entity: p.entity,
-                    global_id: &p.global_id,
-                    piece: p.piece,
-                    name: p.name.as_deref(),
-                    ifc_type: &p.ifc_type,
+                ReadMember {
+                    member: MemberId::of(p),
                     predefined_type: p.predefined_type.as_deref(),
                     parent_global_id: p
                         .parent
                         .and_then(|id| model.groups.get(&id))
                         .map(|g| g.global_id.as_str()),
                     material: p.material.as_deref(),
-                    axis_start: round_point(&start),
-                    axis_end: round_point(&end),
-                    width: round_m(p.obox.width()),
-                    thickness: round_m(p.obox.thickness()),
-                    length: round_m(p.obox.length()),
+                    shape: MemberShape::of(p, &start, &end),
                     volume: (p.obox.volume() * 1e12).round() / 1e12,
                 }
             })
@@ -109,9 +94,9 @@ impl<'m> InspectReport<'m> {
         let mut by_type: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
         let mut products = std::collections::BTreeSet::new();
         for m in &self.members {
-            let slot = by_type.entry(m.ifc_type).or_default();
+            let slot = by_type.entry(m.member.ifc_type).or_default();
             slot.1 += 1;
-            if products.insert(m.entity) {
+            if products.insert(m.member.entity) {
                 slot.0 += 1;
             }
         }

@@ -9,6 +9,7 @@ pub mod glb;
 pub mod html;
 pub mod inspect;
 pub mod markup_text;
+pub mod member;
 mod mesh;
 pub mod panels;
 pub mod plan;

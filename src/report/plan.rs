@@ -1,6 +1,7 @@
 //! The `plan` report (DESIGN §8): members with wall and role, walls with
 //! frame, assembly order, precedence, nailing and framing targets.
 
+use super::member::{MemberId, MemberShape};
 use super::panels::{
     BreakRow, LimitsRow, PanelRow, SiteRow, break_rows, panel_rows, site_rows, text_line,
 };
@@ -17,7 +18,7 @@ use std::fmt::Write;
 pub struct PlanReport<'a> {
     pub schema: String,
     pub length_unit: LengthUnit,
-    pub members: Vec<MemberRow<'a>>,
+    pub members: Vec<PlannedMember<'a>>,
     pub walls: Vec<WallRow<'a>>,
     pub warnings: Vec<String>,
     /// The panel limits walls were split to (absent when the rules derive none).
@@ -31,21 +32,16 @@ pub struct PlanReport<'a> {
     pub role_check: Option<&'a super::role_check::RoleCheck>,
 }
 
+/// A piece as the plan sees it: its wall and role; a horizontal member's axis from its
+/// smaller-u end.
 #[derive(Debug, Serialize)]
-pub struct MemberRow<'a> {
-    pub id: &'a str,
-    pub entity: u64,
-    pub global_id: &'a str,
-    pub piece: Option<usize>,
-    pub name: Option<&'a str>,
-    pub ifc_type: &'a str,
+pub struct PlannedMember<'a> {
+    #[serde(flatten)]
+    pub member: MemberId<'a>,
     pub wall_id: Option<&'a str>,
     pub role: Option<&'a str>,
-    pub axis_start: [f64; 3],
-    pub axis_end: [f64; 3],
-    pub width: f64,
-    pub thickness: f64,
-    pub length: f64,
+    #[serde(flatten)]
+    pub shape: MemberShape,
     pub mass: f64,
 }
 
@@ -168,20 +164,11 @@ impl<'a> PlanReport<'a> {
                         std::mem::swap(&mut start, &mut end);
                     }
                 }
-                MemberRow {
-                    id: &p.id,
-                    entity: p.entity,
-                    global_id: &p.global_id,
-                    piece: p.piece,
-                    name: p.name.as_deref(),
-                    ifc_type: &p.ifc_type,
-                    role: lookup.role[i],
+                PlannedMember {
+                    member: MemberId::of(p),
                     wall_id,
-                    axis_start: round_point(&start),
-                    axis_end: round_point(&end),
-                    width: round_m(p.obox.width()),
-                    thickness: round_m(p.obox.thickness()),
-                    length: round_m(p.obox.length()),
+                    role: lookup.role[i],
+                    shape: MemberShape::of(p, &start, &end),
                     mass: (lookup.mass[i] * 1e6).round() / 1e6,
                 }
             })

@@ -9,6 +9,7 @@ use super::wall_view::{PieceView, WallView};
 use crate::cell::Cell;
 use crate::frame::panel::WallPanels;
 use crate::sim::Simulation;
+use crate::sim::record::Op;
 use maud::{Markup, html};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
@@ -383,7 +384,7 @@ pub(super) fn timeline(view: &WallView) -> Markup {
                         }
                     }
                     @if p.class == "framing-failed" || p.class == "not-attempted" {
-                        @let t = view.record.operations.iter().filter(|o| o.piece == p.id && o.op != "nail").map(|o| o.end).fold(0.0, f64::max);
+                        @let t = view.record.operations.iter().filter(|o| o.piece == p.id && o.op != Op::Nail).map(|o| o.end).fold(0.0, f64::max);
                         text class="failure" x=(f1(x(t) + 2.0)) y=(f1(y + ROW - 3.0)) font-size="12" fill="#c62828" {
                             "✕" title { (p.reason) }
                         }

@@ -9,22 +9,18 @@ mod executor;
 mod motion;
 mod physics;
 pub mod planner;
-mod prepare;
 mod reach;
 pub mod record;
 
 pub use executor::NailPlan;
 pub use motion::{JointMove, LinearMove, Profile};
-pub use prepare::{Prepared, prepare, prepare_facts, whole_facts};
 pub use record::WallRecord;
 
 use crate::cell::Cell;
-use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, reason};
+use crate::frame::{Facts, FrameError, Reasoned, RuleEngine};
 use crate::ifc::Model;
 use crate::world::{Scene, SceneWall, WorldError};
-use std::collections::BTreeSet;
 
 /// How to simulate.
 #[derive(Debug, Clone)]
@@ -39,7 +35,13 @@ pub struct SimOptions {
     pub engine: RuleEngine,
     /// When rapier steps: every time step, or only while something can move on its own.
     pub stepping: Stepping,
+    /// The bound on simulated time per wall, s: a wall still running past it stops the run
+    /// with an error (`SimError::TimeLimit`).
+    pub max_seconds_per_wall: f64,
 }
+
+/// The default physics time step, s (240 Hz).
+pub const DEFAULT_DT: f64 = 1.0 / 240.0;
 
 /// How the executor advances time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -66,10 +68,11 @@ impl Default for SimOptions {
     fn default() -> Self {
         SimOptions {
             walls: Vec::new(),
-            dt: 1.0 / 240.0,
+            dt: DEFAULT_DT,
             speed: 1.0,
             engine: RuleEngine::Compiled,
             stepping: Stepping::Events,
+            max_seconds_per_wall: DEFAULT_MAX_SIM_SECONDS_PER_WALL,
         }
     }
 }
@@ -87,13 +90,6 @@ pub enum SimError {
     #[error("bad simulation option: {0}")]
     Option(String),
     #[error(
-        "{variable}={value:?} is not a number of seconds above 0; set it to one (e.g. {variable}=36000) or unset it for the default {DEFAULT_MAX_SIM_SECONDS_PER_WALL} s"
-    )]
-    BadLimit {
-        variable: &'static str,
-        value: String,
-    },
-    #[error(
         "{wall} did not finish within the bound of {limit} s of simulated time per wall (it had run {reached:.1} s); raise the bound with {ENV_MAX_SIM_SECONDS_PER_WALL}=SECONDS if the wall really takes longer"
     )]
     TimeLimit {
@@ -103,26 +99,11 @@ pub enum SimError {
     },
 }
 
-/// The environment variable that sets the bound on simulated time per wall (s).
+/// The environment variable with which the CLI sets the bound on simulated time per wall (s).
 pub const ENV_MAX_SIM_SECONDS_PER_WALL: &str = "FRAMEWRIGHT_MAX_SIM_SECONDS_PER_WALL";
 /// The bound's default: 10 h of simulated time, some ten times the longest wall of the
 /// 3-storey test model.
 pub const DEFAULT_MAX_SIM_SECONDS_PER_WALL: f64 = 36_000.0;
-
-/// The bound on simulated time per wall (s): the environment's value, else the default; a
-/// value that is not a positive number is an error naming the variable.
-pub fn max_sim_seconds_per_wall() -> Result<f64, SimError> {
-    match std::env::var(ENV_MAX_SIM_SECONDS_PER_WALL) {
-        Err(_) => Ok(DEFAULT_MAX_SIM_SECONDS_PER_WALL),
-        Ok(value) => match value.trim().parse::<f64>() {
-            Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-            _ => Err(SimError::BadLimit {
-                variable: ENV_MAX_SIM_SECONDS_PER_WALL,
-                value,
-            }),
-        },
-    }
-}
 
 /// A finished simulation.
 pub struct Simulation {
@@ -138,56 +119,12 @@ pub struct Simulation {
     /// The model cut into panels, when a wall was split: the pieces the scene, the plan and
     /// the records name (cut plates, added studs).
     pub panelized: Option<Model>,
-}
-
-/// Simulates the walls of a model in a cell.
-pub fn simulate(model: &Model, cell: &Cell, options: &SimOptions) -> Result<Simulation, SimError> {
-    simulate_with_progress(model, "model", cell, options, &|_, _, _| {})
-}
-
-/// `simulate`, reporting (wall id, elements done, elements) as walls progress.
-pub fn simulate_with_progress(
-    model: &Model,
-    model_name: &str,
-    cell: &Cell,
-    options: &SimOptions,
-    progress: &(dyn Fn(&str, usize, usize) + Sync),
-) -> Result<Simulation, SimError> {
-    check_options(options)?;
-    let prepared = prepare(model, model_name, cell, &options.engine)?;
-    let selected = select_walls(&prepared.plan, &options.walls)?;
-    let records = run_prepared(&prepared, cell, options, &selected, progress)?;
-    Simulation::from_prepared(prepared, records, &options.engine)
+    /// The plan of the model's own walls, each with its panels, when a wall was split
+    /// (otherwise `plan` is that plan).
+    pub model_plan: Option<Plan>,
 }
 
 impl Simulation {
-    /// The simulation of `records` (in wall order): their facts added to the prepared facts
-    /// and reasoned over with the rule base.
-    pub fn from_prepared(
-        prepared: Prepared,
-        records: Vec<WallRecord>,
-        engine: &RuleEngine,
-    ) -> Result<Simulation, SimError> {
-        let Prepared {
-            mut facts,
-            scene,
-            plan,
-            panelized,
-            ..
-        } = prepared;
-        let sim_facts = records_facts(&records);
-        facts.extend(sim_facts.clone());
-        let reasoned = reason(&facts, engine, false)?;
-        Ok(Simulation {
-            scene,
-            plan,
-            records,
-            facts: sim_facts,
-            reasoned,
-            panelized,
-        })
-    }
-
     /// The model the simulation's pieces come from: the panelized one, else `model`.
     pub fn model<'a>(&'a self, model: &'a Model) -> &'a Model {
         self.panelized.as_ref().unwrap_or(model)
@@ -203,48 +140,18 @@ pub fn records_facts(records: &[WallRecord]) -> Facts {
     facts
 }
 
-/// A run prepared for the walls `options.walls` names. Walls named by their key pieces (as
-/// `wall_of` names them) are planned from their spatial containers' facts alone (no rule
-/// relates pieces of two containers, see `frame::containers`), so one wall of a big model
-/// costs its storey's reasoning, not the model's; their records are those `simulate` gives.
-pub fn prepare_named_walls(
-    model: &Model,
-    cell: &Cell,
-    options: &SimOptions,
-) -> Result<Prepared, SimError> {
-    check_options(options)?;
-    let facts = whole_facts(model, cell);
-    // A wall named otherwise (by name, or by no piece) keeps the whole model.
-    let mut containers = BTreeSet::new();
-    let mut each_in_one = !options.walls.is_empty();
-    for wall in &options.walls {
-        let of_wall = containers_of(&facts, &BTreeSet::from([wall.as_str()]));
-        each_in_one &= !of_wall.is_empty();
-        containers.extend(of_wall);
-    }
-    let restrict = |facts: Facts| {
-        if each_in_one {
-            restrict_to_containers(&facts, &containers)
-        } else {
-            facts
-        }
-    };
-    let facts = restrict(facts);
-    prepare_facts(model, "model", cell, &options.engine, facts, &restrict)
-}
-
-/// Runs the walls `selected` (keys, in plan order) of a prepared run in parallel: one record
+/// Runs the walls `selected` (keys, in plan order) of a planned scene in parallel: one record
 /// per wall, in their order.
-pub fn run_prepared(
-    prepared: &Prepared,
+pub fn run_walls(
+    scene: &Scene,
+    plan: &Plan,
     cell: &Cell,
     options: &SimOptions,
     selected: &[String],
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<Vec<WallRecord>, SimError> {
     check_options(options)?;
-    let limit = max_sim_seconds_per_wall()?;
-    let (scene, plan) = (&prepared.scene, &prepared.plan);
+    let limit = options.max_seconds_per_wall;
     // The rules name a wall by its key piece; the scene does too.
     let walls: Vec<&SceneWall> = selected
         .iter()
@@ -309,7 +216,8 @@ fn largest_first<T: Sync, R: Send>(
         .collect()
 }
 
-/// The option checks of `simulate`: a time step in (0, 0.05] s, a speed fraction in (0, 1].
+/// The option checks of `simulate`: a time step in (0, 0.05] s, a speed fraction in (0, 1], a
+/// time bound above 0 s.
 pub fn check_options(options: &SimOptions) -> Result<(), SimError> {
     if !(options.dt > 0.0 && options.dt <= 0.05) {
         return Err(SimError::Option(format!(
@@ -321,6 +229,12 @@ pub fn check_options(options: &SimOptions) -> Result<(), SimError> {
         return Err(SimError::Option(format!(
             "the speed fraction must be in (0, 1], not {}",
             options.speed
+        )));
+    }
+    if options.max_seconds_per_wall.is_nan() || options.max_seconds_per_wall <= 0.0 {
+        return Err(SimError::Option(format!(
+            "the bound on simulated time per wall must be above 0 s, not {}",
+            options.max_seconds_per_wall
         )));
     }
     Ok(())

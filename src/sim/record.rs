@@ -8,11 +8,63 @@ use nalgebra::Isometry3;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
+/// What the executor does to a piece, in the words its records and the rules use. Declared in
+/// the order of their names, so records sorted by operation sort as by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Op {
+    /// Conveyor 1 brings the piece to the pick point.
+    Feed,
+    /// From the pick to above the place pose.
+    Move,
+    /// One nail driven.
+    Nail,
+    /// Grip and lift off the belt.
+    Pick,
+    /// Down to the framing target and release.
+    Place,
+    /// Back up from the placed piece.
+    Retract,
+}
+
+impl Op {
+    pub const ALL: [Op; 6] = [
+        Op::Feed,
+        Op::Move,
+        Op::Nail,
+        Op::Pick,
+        Op::Place,
+        Op::Retract,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Op::Feed => "feed",
+            Op::Move => "move",
+            Op::Nail => "nail",
+            Op::Pick => "pick",
+            Op::Place => "place",
+            Op::Retract => "retract",
+        }
+    }
+
+    /// The operation named `name`, if any.
+    pub fn from_name(name: &str) -> Option<Op> {
+        Op::ALL.into_iter().find(|op| op.name() == name)
+    }
+}
+
+impl std::fmt::Display for Op {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// One operation on an element.
 #[derive(Debug, Clone, Serialize)]
 pub struct Operation {
     pub piece: String,
-    pub op: &'static str,
+    pub op: Op,
     pub start: f64,
     pub end: f64,
 }
@@ -21,7 +73,7 @@ pub struct Operation {
 #[derive(Debug, Clone, Serialize)]
 pub struct IkRecord {
     pub piece: String,
-    pub op: &'static str,
+    pub op: Op,
     pub result: Result<f64, IkFailure>,
 }
 
@@ -29,7 +81,7 @@ pub struct IkRecord {
 #[derive(Debug, Clone, Serialize)]
 pub struct ContactRecord {
     pub piece: String,
-    pub op: &'static str,
+    pub op: Op,
     /// First time of the contact in this operation.
     pub t: f64,
     pub body_a: String,
@@ -392,7 +444,7 @@ impl WallRecord {
         for o in &self.operations {
             facts.add(
                 "sim_operation",
-                vec![s(&o.piece), s(o.op), f(o.start), f(o.end)],
+                vec![s(&o.piece), s(o.op.name()), f(o.start), f(o.end)],
                 event(&format!("{} of {} at t = {:.3} s", o.op, o.piece, o.start)),
             );
         }
@@ -401,7 +453,7 @@ impl WallRecord {
             match &r.result {
                 Ok(margin) => facts.add(
                     "sim_ik_solved",
-                    vec![s(&r.piece), s(r.op), f(*margin)],
+                    vec![s(&r.piece), s(r.op.name()), f(*margin)],
                     origin,
                 ),
                 Err(failure) => {
@@ -410,7 +462,7 @@ impl WallRecord {
                         "sim_ik_failed",
                         vec![
                             s(&r.piece),
-                            s(r.op),
+                            s(r.op.name()),
                             s(kind),
                             s(&what),
                             f(value),
@@ -427,7 +479,7 @@ impl WallRecord {
                 "sim_contact",
                 vec![
                     s(&c.piece),
-                    s(c.op),
+                    s(c.op.name()),
                     f(c.t),
                     s(&c.body_a),
                     s(&c.body_b),
@@ -533,6 +585,21 @@ impl WallRecord {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn operations_order_as_their_names_and_read_back_by_name() {
+        let mut by_name = Op::ALL;
+        by_name.sort_by_key(|op| op.name());
+        assert_eq!(by_name, Op::ALL, "declared in the order of their names");
+        let mut by_ord = Op::ALL;
+        by_ord.sort();
+        assert_eq!(by_ord, Op::ALL);
+        for op in Op::ALL {
+            assert_eq!(Op::from_name(op.name()), Some(op));
+            assert_eq!(serde_json::to_string(&op).unwrap(), format!("\"{op}\""));
+        }
+        assert_eq!(Op::from_name("weld"), None);
+    }
 
     #[test]
     fn a_sample_pairs_pieces_with_their_tracks_and_notes_new_and_gone_ones() {

@@ -55,7 +55,7 @@ pub struct StepError {
 }
 
 impl StepError {
-    pub(crate) fn new(kind: StepErrorKind) -> Self {
+    pub fn new(kind: StepErrorKind) -> Self {
         StepError {
             kind,
             line: 0,

@@ -2,7 +2,7 @@
 //! variables that set them.
 
 /// Limits applied while reading; each bounds memory or time by the input's size.
-/// `from_env` raises them through `FRAMEWRIGHT_MAX_IFC_*` environment variables.
+/// The CLI raises them through the `FRAMEWRIGHT_MAX_IFC_*` environment variables.
 #[derive(Debug, Clone, Copy)]
 pub struct ReadOptions {
     /// Files larger than this are refused before any work is done.

@@ -1,37 +1,9 @@
 //! The bytes of a file: memory-mapped when possible, owned otherwise.
 
 use super::error::{StepError, StepErrorKind};
-use super::limits::{
-    ENV_MAX_BYTES, ENV_MAX_DEPTH, ENV_MAX_INSTANCES, ENV_MAX_STRING_BYTES, ReadOptions,
-};
+use super::limits::ReadOptions;
 use std::fs::File;
 use std::path::Path;
-
-impl ReadOptions {
-    /// The defaults, with any limit set in the environment; a value that is not a
-    /// whole number is an error naming the variable.
-    pub fn from_env() -> Result<ReadOptions, StepError> {
-        fn var(name: &'static str) -> Result<Option<u64>, StepError> {
-            match std::env::var(name) {
-                Ok(v) => v.trim().parse::<u64>().map(Some).map_err(|_| {
-                    StepError::new(StepErrorKind::BadLimit {
-                        variable: name,
-                        value: v,
-                    })
-                }),
-                Err(_) => Ok(None),
-            }
-        }
-        let d = ReadOptions::default();
-        let size = |v: Option<u64>, default: usize| v.map_or(default, |v| v as usize);
-        Ok(ReadOptions {
-            max_bytes: var(ENV_MAX_BYTES)?.unwrap_or(d.max_bytes),
-            max_depth: size(var(ENV_MAX_DEPTH)?, d.max_depth),
-            max_instances: size(var(ENV_MAX_INSTANCES)?, d.max_instances),
-            max_string_bytes: size(var(ENV_MAX_STRING_BYTES)?, d.max_string_bytes),
-        })
-    }
-}
 
 pub enum Source {
     Mapped(memmap2::Mmap),

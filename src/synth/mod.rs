@@ -7,11 +7,9 @@
 
 pub mod building;
 pub mod error;
-pub mod guid;
 pub mod ifc_writer;
 pub mod layout;
 pub mod models;
-pub mod step_text;
 pub mod targets;
 pub mod truth;
 pub mod units;

@@ -12,6 +12,8 @@ pub enum WorldError {
     Cell(#[from] CellError),
     #[error(transparent)]
     Frame(#[from] FrameError),
+    #[error(transparent)]
+    Row(#[from] crate::frame::rows::RowError),
     /// A relation holds a tuple of the wrong shape (possible with a replaced rule directory).
     #[error("relation `{relation}`: {message}")]
     Relation {

@@ -1,11 +1,13 @@
-//! Typed views of the reasoned relations of `rules/targets.dl` and `rules/world.dl`. Each
-//! accessor checks the tuple shapes (a replaced rule directory may declare them differently)
-//! and returns its rows sorted.
+//! Typed views of the reasoned relations of `rules/targets.dl` and `rules/world.dl`, read
+//! through the rule base's typed rows (a replaced rule directory that declares them
+//! differently gives an error naming the relation), each returned sorted.
 
 use super::WorldError;
 use crate::frame::Reasoned;
-use crate::logic::Value;
-use nalgebra::{Isometry3, Vector3};
+use crate::frame::rows::{
+    self, FedWith, FramingTargetWall, PieceIndex, PieceSize, Row, SpawnBeyondBelt, WallOf,
+};
+use nalgebra::Isometry3;
 use std::collections::BTreeMap;
 
 /// A piece's framing target: its body frame (centre of mass, x along the length, y along the
@@ -45,62 +47,43 @@ pub struct WorldPiece {
     pub mass: f64,
 }
 
-fn bad(relation: &'static str, tuple: &[Value], what: &str) -> WorldError {
-    WorldError::Relation {
-        relation,
-        message: format!("expected {what}, got {tuple:?}"),
+/// `x` when it is finite; otherwise an error naming the relation, the row and the attribute.
+fn finite(relation: &'static str, x: f64, row: &dyn std::fmt::Debug) -> Result<f64, WorldError> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(WorldError::Relation {
+            relation,
+            message: format!("a number that is not finite in {row:?}"),
+        })
     }
 }
 
-fn symbol(relation: &'static str, t: &[Value], k: usize, what: &str) -> Result<String, WorldError> {
-    t.get(k)
-        .and_then(Value::as_symbol)
-        .map(str::to_string)
-        .ok_or_else(|| bad(relation, t, what))
-}
-
-fn iso(
-    relation: &'static str,
-    t: &[Value],
-    k: usize,
-    what: &str,
-) -> Result<Isometry3<f64>, WorldError> {
-    match t.get(k) {
-        Some(Value::Iso(i)) => Ok(i.0),
-        _ => Err(bad(relation, t, what)),
-    }
-}
-
-fn float(relation: &'static str, t: &[Value], k: usize, what: &str) -> Result<f64, WorldError> {
-    t.get(k)
-        .and_then(Value::as_float)
-        .filter(|x| x.is_finite())
-        .ok_or_else(|| bad(relation, t, what))
+/// The wall of every piece (`wall_of`).
+fn walls_of(r: &Reasoned) -> Result<BTreeMap<&'static str, &'static str>, WorldError> {
+    Ok(r.rows::<WallOf>()?
+        .into_iter()
+        .map(|w| (w.p, w.w))
+        .collect())
 }
 
 /// Every framing target by wall, each wall's targets sorted by piece id.
 pub fn framing_targets(r: &Reasoned) -> Result<BTreeMap<String, Vec<FramingTarget>>, WorldError> {
-    const REL: &str = "framing_target";
-    const WHAT: &str = "(piece: symbol, pose: iso)";
-    let wall_of: BTreeMap<&str, &str> = r
-        .get("wall_of")
-        .iter()
-        .filter_map(|t| Some((t.first()?.as_symbol()?, t.get(1)?.as_symbol()?)))
-        .collect();
+    let wall_of = walls_of(r)?;
     let mut out: BTreeMap<String, Vec<FramingTarget>> = BTreeMap::new();
-    for t in r.get(REL) {
-        let piece = symbol(REL, t, 0, WHAT)?;
-        let pose = iso(REL, t, 1, WHAT)?;
+    for t in r.rows::<rows::FramingTarget>()? {
         let wall = wall_of
-            .get(piece.as_str())
+            .get(t.p)
             .ok_or_else(|| WorldError::Relation {
-                relation: REL,
-                message: format!("piece `{piece}` has a target but no wall (wall_of)"),
+                relation: rows::FramingTarget::RELATION,
+                message: format!("piece `{}` has a target but no wall (wall_of)", t.p),
             })?
             .to_string();
-        out.entry(wall.clone())
-            .or_default()
-            .push(FramingTarget { piece, wall, pose });
+        out.entry(wall.clone()).or_default().push(FramingTarget {
+            piece: t.p.to_string(),
+            wall,
+            pose: t.pose,
+        });
     }
     for targets in out.values_mut() {
         targets.sort_by(|a, b| a.piece.cmp(&b.piece));
@@ -110,27 +93,21 @@ pub fn framing_targets(r: &Reasoned) -> Result<BTreeMap<String, Vec<FramingTarge
 
 /// The laid-flat frame of every wall in the robot frame (`framing_target_wall`).
 pub fn framing_target_walls(r: &Reasoned) -> Result<BTreeMap<String, Isometry3<f64>>, WorldError> {
-    const REL: &str = "framing_target_wall";
-    const WHAT: &str = "(w: symbol, wall_to_robot: iso)";
-    r.get(REL)
-        .iter()
-        .map(|t| Ok((symbol(REL, t, 0, WHAT)?, iso(REL, t, 1, WHAT)?)))
-        .collect()
+    Ok(r.rows::<FramingTargetWall>()?
+        .into_iter()
+        .map(|t| (t.w.to_string(), t.wall_to_robot))
+        .collect())
 }
 
 /// The spawns wall by wall (walls in file order of their first piece), each
 /// wall's queue in slot order; an error when two pieces of a wall share a slot
 /// or a piece has two.
 pub fn spawns(r: &Reasoned) -> Result<Vec<Spawn>, WorldError> {
-    let wall_of: BTreeMap<&str, &str> = r
-        .get("wall_of")
-        .iter()
-        .filter_map(|t| Some((t.first()?.as_symbol()?, t.get(1)?.as_symbol()?)))
-        .collect();
+    let wall_of = walls_of(r)?;
     let index: BTreeMap<&str, i64> = r
-        .get("piece_index")
-        .iter()
-        .filter_map(|t| Some((t.first()?.as_symbol()?, t.get(1)?.as_number()?)))
+        .rows::<PieceIndex>()?
+        .into_iter()
+        .map(|t| (t.p, t.i))
         .collect();
     let wall_rank = |piece: &str| {
         wall_of
@@ -139,19 +116,17 @@ pub fn spawns(r: &Reasoned) -> Result<Vec<Spawn>, WorldError> {
             .copied()
             .unwrap_or(i64::MAX)
     };
-    const REL: &str = "spawn";
-    const WHAT: &str = "(p: symbol, slot: number >= 0, pose: iso)";
+    const REL: &str = rows::Spawn::RELATION;
     let mut out = Vec::new();
-    for t in r.get(REL) {
-        let slot = t
-            .get(1)
-            .and_then(Value::as_number)
-            .and_then(|n| usize::try_from(n).ok())
-            .ok_or_else(|| bad(REL, t, WHAT))?;
+    for t in r.rows::<rows::Spawn>()? {
+        let slot = usize::try_from(t.slot).map_err(|_| WorldError::Relation {
+            relation: REL,
+            message: format!("piece `{}` spawns in slot {} (below 0)", t.p, t.slot),
+        })?;
         out.push(Spawn {
-            piece: symbol(REL, t, 0, WHAT)?,
+            piece: t.p.to_string(),
             slot,
-            pose: iso(REL, t, 2, WHAT)?,
+            pose: t.pose,
         });
     }
     out.sort_by(|a, b| {
@@ -183,20 +158,16 @@ pub fn spawns(r: &Reasoned) -> Result<Vec<Spawn>, WorldError> {
 
 /// Size and mass of every spawned piece (`world_piece`).
 pub fn world_pieces(r: &Reasoned) -> Result<BTreeMap<String, WorldPiece>, WorldError> {
-    const REL: &str = "world_piece";
-    const WHAT: &str = "(p: symbol, size: vec3, mass: float)";
-    r.get(REL)
-        .iter()
+    r.rows::<rows::WorldPiece>()?
+        .into_iter()
         .map(|t| {
-            let size: Vector3<f64> = match t.get(1) {
-                Some(Value::Vec3(v)) => v.0,
-                _ => return Err(bad(REL, t, WHAT)),
-            };
+            let mass = finite(rows::WorldPiece::RELATION, t.mass, &t)?;
+            let size = t.size;
             Ok((
-                symbol(REL, t, 0, WHAT)?,
+                t.p.to_string(),
                 WorldPiece {
                     size: [size.x, size.y, size.z],
-                    mass: float(REL, t, 2, WHAT)?,
+                    mass,
                 },
             ))
         })
@@ -205,37 +176,38 @@ pub fn world_pieces(r: &Reasoned) -> Result<BTreeMap<String, WorldPiece>, WorldE
 
 /// Pieces queued beyond the upstream end of conveyor 1, with their overhang (m).
 pub fn spawn_beyond_belt(r: &Reasoned) -> Result<BTreeMap<String, f64>, WorldError> {
-    const REL: &str = "spawn_beyond_belt";
-    const WHAT: &str = "(p: symbol, overhang: float)";
-    r.get(REL)
-        .iter()
-        .map(|t| Ok((symbol(REL, t, 0, WHAT)?, float(REL, t, 1, WHAT)?)))
+    r.rows::<SpawnBeyondBelt>()?
+        .into_iter()
+        .map(|t| {
+            let overhang = finite(SpawnBeyondBelt::RELATION, t.overhang, &t)?;
+            Ok((t.p.to_string(), overhang))
+        })
         .collect()
 }
 
 /// Every piece riding inside another that is fed (`fed_with`: a pre-assembled member's plies,
 /// a duplicated member's copy), as (piece, the piece fed), sorted.
 pub fn fed_with(r: &Reasoned) -> Result<Vec<(String, String)>, WorldError> {
-    const REL: &str = "fed_with";
-    const WHAT: &str = "(p: symbol, lead: symbol)";
-    let mut rows: Vec<(String, String)> = r
-        .get(REL)
-        .iter()
-        .map(|t| Ok((symbol(REL, t, 0, WHAT)?, symbol(REL, t, 1, WHAT)?)))
-        .collect::<Result<_, WorldError>>()?;
-    rows.sort();
-    Ok(rows)
+    let mut fed: Vec<(String, String)> = r
+        .rows::<FedWith>()?
+        .into_iter()
+        .map(|t| (t.p.to_string(), t.lead.to_string()))
+        .collect();
+    fed.sort();
+    Ok(fed)
 }
 
 /// Every piece's box size (length, width, thickness; m) by id (`piece_size`).
 pub fn piece_sizes(r: &Reasoned) -> Result<BTreeMap<String, [f64; 3]>, WorldError> {
-    const REL: &str = "piece_size";
-    const WHAT: &str = "(p: symbol, length: float, width: float, thickness: float)";
-    r.get(REL)
-        .iter()
+    const REL: &str = PieceSize::RELATION;
+    r.rows::<PieceSize>()?
+        .into_iter()
         .map(|t| {
-            let f = |k| float(REL, t, k, WHAT);
-            Ok((symbol(REL, t, 0, WHAT)?, [f(1)?, f(2)?, f(3)?]))
+            let size = [t.length, t.width, t.thickness];
+            for x in size {
+                finite(REL, x, &t)?;
+            }
+            Ok((t.p.to_string(), size))
         })
         .collect()
 }

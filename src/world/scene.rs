@@ -6,7 +6,7 @@ use super::relations::{
     world_pieces,
 };
 use crate::cell::{Cell, Conveyor, Floor, PlacedShape, ToolTable, TouchSensor};
-use crate::frame::{Reasoned, RuleEngine, cell_facts, model_facts, reason};
+use crate::frame::{Reasoned, RuleEngine, cell_facts, model_facts};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
 use nalgebra::Isometry3;
@@ -126,8 +126,8 @@ impl Scene {
     pub fn reason(model: &Model, cell: &Cell, engine: &RuleEngine) -> Result<Reasoned, WorldError> {
         let mut facts = model_facts(model, &ContactOptions::default());
         facts.extend(cell_facts(cell));
-        crate::frame::placement::add_placement_facts(&mut facts, cell, engine)?;
-        Ok(reason(&facts, engine, false)?)
+        let limits = crate::frame::RuleLimits::default();
+        Ok(crate::frame::placement::reason_placing(facts, cell, engine, None, &limits)?.0)
     }
 
     /// Opens a model, reasons with the built-in (compiled) rules and builds its scene.

@@ -9,9 +9,9 @@
 use super::BcfHeader;
 use crate::frame::plan::Wall;
 use crate::ifc::Model;
+use crate::ifc::guid::hash128;
 use crate::logic::Value;
 use crate::sim::Simulation;
-use crate::synth::guid::hash128;
 use nalgebra::{Point3, Vector3};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;

@@ -5,7 +5,7 @@
 //! wants only relations `plan` reads gets them from `builtin_plan`, the rule base cut down to
 //! the rules those depend on (`build.rs`, `frame::rule_reads`).
 
-use super::{BUILTIN_PLAN_RELATIONS, Relations, builtin_plan, builtin_rules, rt};
+use super::{BUILTIN_PLAN_RELATIONS, CompiledError, Relations, builtin_plan, builtin_rules, rt};
 use crate::logic::value::{Column, F64, OBox, Sym, Value, Vec3};
 
 /// What one run gives: the named relations (each sorted, no duplicates) and how many tuples
@@ -184,7 +184,7 @@ pub fn handles(edb: &Relations, wanted: &[&str]) -> bool {
 /// Runs the built-in rule base on `edb` and returns the relations named in `wanted` (callers
 /// check `handles` first; others are left out). `tuples` counts what the copy that ran
 /// derived (the cut copy derives less).
-pub fn run_selected(edb: &Relations, wanted: &[&str]) -> Result<SelectedRun, String> {
+pub fn run_selected(edb: &Relations, wanted: &[&str]) -> Result<SelectedRun, CompiledError> {
     let no_search = None::<(&[&str], fn(&Relations) -> Relations)>;
     if in_plan_scope(wanted) {
         run_copy::<builtin_plan::Prog>(edb, wanted, no_search)
@@ -203,7 +203,7 @@ pub fn run_placed(
     first: &[&str],
     wanted: &[&str],
     place: impl FnOnce(&Relations) -> Relations,
-) -> Result<SelectedRun, String> {
+) -> Result<SelectedRun, CompiledError> {
     if in_plan_scope(first) && in_plan_scope(wanted) {
         run_copy::<builtin_plan::Prog>(edb, wanted, Some((first, place)))
     } else {
@@ -217,7 +217,7 @@ fn run_copy<P: Tables>(
     edb: &Relations,
     wanted: &[&str],
     search: Option<(&[&str], impl FnOnce(&Relations) -> Relations)>,
-) -> Result<SelectedRun, String> {
+) -> Result<SelectedRun, CompiledError> {
     rt::reset_error();
     let mut p = P::default();
     p.fill_inputs(edb);

@@ -8,13 +8,14 @@
 pub mod builtin;
 pub mod rt;
 
+pub use crate::logic::error::CompiledError;
 use crate::logic::value::Value;
 use std::collections::BTreeMap;
 
 /// Input or output relations by name, tuples sorted.
 pub type Relations = BTreeMap<String, Vec<Vec<Value>>>;
 /// A generated program's entry point.
-pub type RunFn = fn(&Relations) -> Result<Relations, String>;
+pub type RunFn = fn(&Relations) -> Result<Relations, CompiledError>;
 
 include!(concat!(env!("OUT_DIR"), "/logic_compiled.rs"));
 

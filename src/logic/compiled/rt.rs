@@ -2,28 +2,32 @@
 //! interpreter (`logic::ops`), with runtime errors recorded in a thread-local
 //! slot (ascent rules cannot return errors) and typed aggregators.
 
+use crate::logic::error::{CompiledError, EvalError};
 use crate::logic::ops;
 use crate::logic::value::{F64, Sym};
 use std::cell::RefCell;
 
 thread_local! {
-    static ERROR: RefCell<Option<String>> = const { RefCell::new(None) };
+    static ERROR: RefCell<Option<CompiledError>> = const { RefCell::new(None) };
 }
 
 pub fn reset_error() {
     ERROR.with(|e| *e.borrow_mut() = None);
 }
 
-pub fn take_error() -> Option<String> {
+pub fn take_error() -> Option<CompiledError> {
     ERROR.with(|e| e.borrow_mut().take())
 }
 
 /// Keep the first error; the caller discards the run's results.
-fn fail<T>(rule: &str, msg: String, fallback: T) -> T {
+fn fail<T>(rule: &str, msg: EvalError, fallback: T) -> T {
     ERROR.with(|e| {
         let mut e = e.borrow_mut();
         if e.is_none() {
-            *e = Some(format!("runtime error in {rule}: {msg}"));
+            *e = Some(CompiledError {
+                rule: rule.to_string(),
+                message: msg,
+            });
         }
     });
     fallback

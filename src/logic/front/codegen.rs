@@ -11,7 +11,33 @@
 use super::Program;
 use super::ast::*;
 use std::collections::{BTreeMap, BTreeSet};
-use std::fmt::Write as _;
+use std::fmt::{self, Write as _};
+
+/// Why a rule program cannot be compiled to ascent: the rule and what in it the compiled
+/// engine does not support. (Std only, as the rest of `front`: `build.rs` includes it.)
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CodegenError {
+    /// The rule's name (`Program::rule_name`).
+    pub rule: String,
+    pub reason: &'static str,
+}
+
+impl CodegenError {
+    fn new(b: &Body, reason: &'static str) -> Self {
+        CodegenError {
+            rule: b.rule_name.clone(),
+            reason,
+        }
+    }
+}
+
+impl fmt::Display for CodegenError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.rule, self.reason)
+    }
+}
+
+impl std::error::Error for CodegenError {}
 
 fn rust_ty(t: BaseTy) -> &'static str {
     match t {
@@ -53,7 +79,7 @@ struct Body {
     rule_name: String,
 }
 
-pub fn generate(prog: &Program, module: &str) -> Result<String, String> {
+pub fn generate(prog: &Program, module: &str) -> Result<String, CodegenError> {
     let mut g = Gen {
         prog,
         aux_decls: Vec::new(),
@@ -63,9 +89,7 @@ pub fn generate(prog: &Program, module: &str) -> Result<String, String> {
     };
     let mut rules_text = String::new();
     for (i, rule) in prog.rules.iter().enumerate() {
-        let text = g
-            .rule(i, rule)
-            .map_err(|e| format!("{}: {e}", prog.rule_name(i)))?;
+        let text = g.rule(i, rule)?;
         rules_text.push_str(&text);
     }
     let mut s = String::new();
@@ -95,7 +119,7 @@ pub fn generate(prog: &Program, module: &str) -> Result<String, String> {
     s.push_str("}\n");
     // Wrapper.
     s.push_str("/// Run on the given input tuples; returns every relation, sorted.\n");
-    s.push_str("pub fn run(edb: &BTreeMap<String, Vec<Vec<Value>>>) -> Result<BTreeMap<String, Vec<Vec<Value>>>, String> {\n");
+    s.push_str("pub fn run(edb: &BTreeMap<String, Vec<Vec<Value>>>) -> Result<BTreeMap<String, Vec<Vec<Value>>>, crate::logic::compiled::CompiledError> {\n");
     s.push_str("    rt::reset_error();\n    let mut p = Prog::default();\n");
     for r in &prog.relations {
         let conv: Vec<String> = r
@@ -175,7 +199,7 @@ impl Gen<'_> {
         format!("__{prefix}{}", self.fresh)
     }
 
-    fn rule(&mut self, id: usize, rule: &Rule) -> Result<String, String> {
+    fn rule(&mut self, id: usize, rule: &Rule) -> Result<String, CodegenError> {
         let head = self.prog.rel_index[&rule.head.rel];
         self.head_recursive = self
             .prog
@@ -209,7 +233,7 @@ impl Gen<'_> {
         })
     }
 
-    fn steps(&mut self, lits: &[Literal], plan: &[Step], b: &mut Body) -> Result<(), String> {
+    fn steps(&mut self, lits: &[Literal], plan: &[Step], b: &mut Body) -> Result<(), CodegenError> {
         for step in plan {
             match step {
                 Step::Scan(i) => {
@@ -285,7 +309,7 @@ impl Gen<'_> {
         Ok(())
     }
 
-    fn scan(&mut self, a: &Atom, b: &mut Body) -> Result<(), String> {
+    fn scan(&mut self, a: &Atom, b: &mut Body) -> Result<(), CodegenError> {
         let mut args = Vec::new();
         let mut post = Vec::new();
         let mut seen: BTreeSet<String> = BTreeSet::new();
@@ -324,8 +348,11 @@ impl Gen<'_> {
         Ok(())
     }
 
-    fn negate(&mut self, a: &Atom, b: &mut Body) -> Result<(), String> {
-        let decl = self.prog.relation(&a.rel).ok_or("unknown relation")?;
+    fn negate(&mut self, a: &Atom, b: &mut Body) -> Result<(), CodegenError> {
+        let decl = self
+            .prog
+            .relation(&a.rel)
+            .ok_or_else(|| CodegenError::new(b, "unknown relation"))?;
         let has_wild = a.args.iter().any(|e| matches!(e.kind, ExprKind::Wild));
         let mut keys = Vec::new();
         for e in a.args.iter().filter(|e| !matches!(e.kind, ExprKind::Wild)) {
@@ -371,7 +398,7 @@ impl Gen<'_> {
     }
 
     /// Bind `result` to the aggregate's value for the current outer bindings.
-    fn aggregate(&mut self, g: &Aggregate, result: &str, b: &mut Body) -> Result<(), String> {
+    fn aggregate(&mut self, g: &Aggregate, result: &str, b: &mut Body) -> Result<(), CodegenError> {
         // Body with `_` in atoms made into distinct variables (each match counts).
         let mut lits = g.body.clone();
         let mut locals: Vec<(String, BaseTy)> = Vec::new();
@@ -438,7 +465,10 @@ impl Gen<'_> {
             // In a recursive stratum that would aggregate over the head's own
             // stratum, which ascent refuses.
             if self.head_recursive {
-                return Err("in a recursive rule the compiled engine needs every outer variable of an aggregate to occur in a positive atom of its body".into());
+                return Err(CodegenError::new(
+                    b,
+                    "in a recursive rule the compiled engine needs every outer variable of an aggregate to occur in a positive atom of its body",
+                ));
             }
             inner = Body {
                 clauses: b.clauses.clone(),
@@ -559,12 +589,12 @@ impl Gen<'_> {
     }
 
     /// Rust code computing an owned value of the expression's type.
-    fn expr(&self, e: &Expr, b: &Body) -> Result<String, String> {
+    fn expr(&self, e: &Expr, b: &Body) -> Result<String, CodegenError> {
         let ty = e.ty.unwrap_or(BaseTy::Number);
         let rn = &b.rule_name;
         Ok(match &e.kind {
             ExprKind::Var(v) => format!("{}.clone()", var_name(v)),
-            ExprKind::Wild => return Err("`_` outside an atom".into()),
+            ExprKind::Wild => return Err(CodegenError::new(b, "`_` outside an atom")),
             ExprKind::Int(i) => match ty {
                 BaseTy::Unsigned => format!("({i}u64)"),
                 BaseTy::Float => float_lit(*i as f64),
@@ -654,7 +684,10 @@ impl Gen<'_> {
                 format!("crate::logic::functors::defs::{name}({})", a.join(", "))
             }
             ExprKind::Agg(_) => {
-                return Err("nested aggregates are not supported by the compiled engine".into());
+                return Err(CodegenError::new(
+                    b,
+                    "nested aggregates are not supported by the compiled engine",
+                ));
             }
         })
     }

@@ -2,19 +2,30 @@
 //! inside the folder they must stay in. A name is checked before the file is
 //! opened, so a refused file is never read, let alone quoted in an error.
 
+use std::fmt;
 use std::path::{Component, Path, PathBuf};
 
-/// Why a name was refused (phrased to follow the name in a message).
-pub type Refusal = String;
+/// Why a name was refused (phrased to follow the name in a message). Std only, as the rest
+/// of `front`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refusal(pub String);
+
+impl fmt::Display for Refusal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Refusal {}
 
 /// `..` or an absolute path in a name given to `.input`/`.output`.
 pub fn check_plain_relative(name: &str) -> Result<(), Refusal> {
     for c in Path::new(name).components() {
         match c {
             Component::Prefix(_) | Component::RootDir => {
-                return Err("is an absolute path".into());
+                return Err(Refusal("is an absolute path".into()));
             }
-            Component::ParentDir => return Err("contains `..`".into()),
+            Component::ParentDir => return Err(Refusal("contains `..`".into())),
             Component::CurDir | Component::Normal(_) => {}
         }
     }
@@ -29,7 +40,7 @@ pub fn canonical_root(root: &Path) -> Result<PathBuf, Refusal> {
         root
     };
     root.canonicalize()
-        .map_err(|e| format!("cannot resolve the folder {}: {e}", root.display()))
+        .map_err(|e| Refusal(format!("cannot resolve the folder {}: {e}", root.display())))
 }
 
 /// Checks that `path` (which may not exist yet) stays under `root` (canonical)
@@ -39,15 +50,17 @@ pub fn check_inside(root: &Path, path: &Path) -> Result<(), Refusal> {
     loop {
         if std::fs::symlink_metadata(probe).is_ok() {
             let real = probe.canonicalize().map_err(|_| {
-                format!(
+                Refusal(format!(
                     "goes through {}, a symbolic link that points nowhere",
                     probe.display()
-                )
+                ))
             })?;
             if real.starts_with(root) {
                 return Ok(());
             }
-            return Err("leaves the folder (through `..` or a symbolic link)".into());
+            return Err(Refusal(
+                "leaves the folder (through `..` or a symbolic link)".into(),
+            ));
         }
         match probe.parent() {
             Some(p) if !p.as_os_str().is_empty() => probe = p,

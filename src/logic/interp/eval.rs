@@ -1,11 +1,12 @@
 //! Expression evaluation on dynamic values (the interpreter's side of `ops`).
 
 use super::compile::CExpr;
+use crate::logic::error::EvalError;
 use crate::logic::front::ast::{BinOp, Builtin, CmpOp};
 use crate::logic::ops;
 use crate::logic::value::{BaseTy, F64, Value};
 
-pub fn eval(e: &CExpr, env: &[Value]) -> Result<Value, String> {
+pub fn eval(e: &CExpr, env: &[Value]) -> Result<Value, EvalError> {
     Ok(match e {
         CExpr::Slot(s) => env[*s as usize].clone(),
         CExpr::Const(v) => v.clone(),
@@ -13,7 +14,7 @@ pub fn eval(e: &CExpr, env: &[Value]) -> Result<Value, String> {
             Value::Number(n) => Value::Number(n.wrapping_neg()),
             Value::Unsigned(n) => Value::Unsigned(n.wrapping_neg()),
             Value::Float(f) => Value::float(-f.0),
-            other => return Err(format!("cannot negate {other}")),
+            other => return Err(EvalError(format!("cannot negate {other}"))),
         },
         CExpr::Bin(op, _, a, b) => bin(*op, eval(a, env)?, eval(b, env)?)?,
         CExpr::Builtin(b, ty, args) => {
@@ -33,7 +34,7 @@ pub fn eval(e: &CExpr, env: &[Value]) -> Result<Value, String> {
     })
 }
 
-fn bin(op: BinOp, a: Value, b: Value) -> Result<Value, String> {
+fn bin(op: BinOp, a: Value, b: Value) -> Result<Value, EvalError> {
     use BinOp::*;
     Ok(match (a, b) {
         (Value::Number(x), Value::Number(y)) => Value::Number(match op {
@@ -60,7 +61,14 @@ fn bin(op: BinOp, a: Value, b: Value) -> Result<Value, String> {
             Rem => x.0 % y.0,
             Pow => x.0.powf(y.0),
         }),
-        (a, b) => return Err(format!("`{}` on {} and {}", op.symbol(), a.ty(), b.ty())),
+        (a, b) => {
+            return Err(EvalError(format!(
+                "`{}` on {} and {}",
+                op.symbol(),
+                a.ty(),
+                b.ty()
+            )));
+        }
     })
 }
 
@@ -68,11 +76,13 @@ fn sym(v: &Value) -> &str {
     v.as_symbol().unwrap_or("")
 }
 
-fn builtin(b: Builtin, ty: BaseTy, v: Vec<Value>) -> Result<Value, String> {
+fn builtin(b: Builtin, ty: BaseTy, v: Vec<Value>) -> Result<Value, EvalError> {
     Ok(match b {
         Builtin::Min | Builtin::Max => {
             let mut it = v.into_iter();
-            let mut acc = it.next().ok_or("min/max of nothing")?;
+            let mut acc = it
+                .next()
+                .ok_or_else(|| EvalError::new("min/max of nothing"))?;
             for x in it {
                 let better = match (&x, &acc) {
                     (Value::Float(a), Value::Float(c)) => {
@@ -114,17 +124,17 @@ fn builtin(b: Builtin, ty: BaseTy, v: Vec<Value>) -> Result<Value, String> {
             (Value::Number(n), _) => ops::i64_to_string(*n),
             (Value::Unsigned(n), _) => ops::u64_to_string(*n),
             (Value::Float(f), _) => ops::f64_to_string(*f),
-            (other, _) => return Err(format!("to_string of {}", other.ty())),
+            (other, _) => return Err(EvalError(format!("to_string of {}", other.ty()))),
         }),
         Builtin::Itof => Value::Float(F64(v[0].as_number().unwrap_or(0) as f64)),
         Builtin::Itou => Value::Unsigned(v[0].as_number().unwrap_or(0) as u64),
         Builtin::Utoi => match v[0] {
             Value::Unsigned(u) => Value::Number(u as i64),
-            _ => return Err("utoi of a non-unsigned value".into()),
+            _ => return Err(EvalError::new("utoi of a non-unsigned value")),
         },
         Builtin::Utof => match v[0] {
             Value::Unsigned(u) => Value::float(u as f64),
-            _ => return Err("utof of a non-unsigned value".into()),
+            _ => return Err(EvalError::new("utof of a non-unsigned value")),
         },
         Builtin::Ftoi => Value::Number(v[0].as_float().unwrap_or(0.0) as i64),
         Builtin::Ftou => Value::Unsigned(v[0].as_float().unwrap_or(0.0) as u64),

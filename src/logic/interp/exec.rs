@@ -4,6 +4,7 @@
 use super::compile::{self, CAgg, CStep, Range};
 use super::eval::{self, compare};
 use super::store::{self, Relation, hash_values};
+use crate::logic::error::EvalError;
 use crate::logic::front::ast::{AggOp, BaseTy};
 use crate::logic::ops;
 use crate::logic::value::Value;
@@ -15,7 +16,7 @@ pub(crate) enum Stop {
     Tuples,
 }
 
-type Cont<'k> = dyn FnMut(&mut Exec<'_>, &mut Vec<Value>) -> Result<(), String> + 'k;
+type Cont<'k> = dyn FnMut(&mut Exec<'_>, &mut Vec<Value>) -> Result<(), EvalError> + 'k;
 
 pub(crate) struct Exec<'a> {
     pub(super) rels: &'a [Relation],
@@ -24,7 +25,7 @@ pub(crate) struct Exec<'a> {
     pub(crate) trail: Vec<(u32, u32)>,
     /// Body tuples this evaluation may still visit.
     pub(super) budget: u64,
-    /// Set when a limit stopped the evaluation (its error string is then only a marker).
+    /// Set when a limit stopped the evaluation (its error is then only a marker).
     pub(super) stop: Option<Stop>,
 }
 
@@ -64,7 +65,7 @@ impl<'a> Exec<'a> {
         steps: &[CStep],
         env: &mut Vec<Value>,
         k: &mut Cont<'_>,
-    ) -> Result<(), String> {
+    ) -> Result<(), EvalError> {
         let Some((step, rest)) = steps.split_first() else {
             return k(self, env);
         };
@@ -244,10 +245,10 @@ impl<'a> Exec<'a> {
         rest: &[CStep],
         env: &mut Vec<Value>,
         k: &mut Cont<'_>,
-    ) -> Result<(), String> {
+    ) -> Result<(), EvalError> {
         if self.budget == 0 {
             self.stop = Some(Stop::Steps);
-            return Err(String::new());
+            return Err(EvalError::default());
         }
         self.budget -= 1;
         let t = r.tuple(id);
@@ -275,13 +276,13 @@ impl<'a> Exec<'a> {
         &mut self,
         agg: &CAgg,
         env: &mut Vec<Value>,
-    ) -> Result<Option<Value>, String> {
+    ) -> Result<Option<Value>, EvalError> {
         let mut count: i64 = 0;
         let mut acc: Option<Value> = None;
         let mut fsum = 0.0f64;
         let trail_len = self.trail.len();
         {
-            let mut k = |_: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
+            let mut k = |_: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), EvalError> {
                 count += 1;
                 if let Some(t) = &agg.target {
                     let v = eval::eval(t, env)?;

@@ -9,7 +9,7 @@ pub mod store;
 
 use self::compile::CRule;
 use self::store::Relation;
-use super::error::LogicError;
+use super::error::{EvalError, LogicError};
 use super::front::Program;
 use super::value::Value;
 use serde::Serialize;
@@ -19,7 +19,7 @@ pub use self::eval::compare;
 pub(crate) use self::exec::Exec;
 
 /// Evaluate a compiled expression (used by explanations).
-pub(crate) fn eval_pub(e: &compile::CExpr, env: &[Value]) -> Result<Value, String> {
+pub(crate) fn eval_pub(e: &compile::CExpr, env: &[Value]) -> Result<Value, EvalError> {
     eval::eval(e, env)
 }
 

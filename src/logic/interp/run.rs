@@ -6,7 +6,7 @@ use super::eval;
 use super::exec::{Exec, Stop};
 use super::store::{Relation, hash_values};
 use super::{Engine, Prov, RunStats, show};
-use crate::logic::error::LogicError;
+use crate::logic::error::{EvalError, LogicError};
 use crate::logic::ops;
 use crate::logic::value::Value;
 
@@ -199,7 +199,7 @@ impl Engine {
     fn finish(
         &self,
         ex: &Exec<'_>,
-        result: Result<(), String>,
+        result: Result<(), EvalError>,
         (si, iteration): (usize, usize),
         rule: &CRule,
         env: &[Value],
@@ -208,7 +208,7 @@ impl Engine {
         match (result, ex.stop) {
             (Ok(()), _) => Ok(()),
             (Err(_), Some(stop)) => Err(self.stop_error(stop, si, rule.id, iteration)),
-            (Err(msg), None) => Err(self.runtime_error(rule, env, msg)),
+            (Err(EvalError(msg)), None) => Err(self.runtime_error(rule, env, msg)),
         }
     }
 
@@ -229,7 +229,7 @@ impl Engine {
         let others: usize = self.rels.iter().map(Relation::len).sum();
         let max_tuples = self.options.limits.max_tuples;
         for steps in &rule.variants {
-            let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
+            let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), EvalError> {
                 tuple.clear();
                 for e in &rule.head {
                     tuple.push(eval::eval(e, env)?);
@@ -238,7 +238,7 @@ impl Engine {
                 let added = head.insert_hashed(&tuple, h).is_some();
                 if added && others + head.len() > max_tuples {
                     ex.stop = Some(Stop::Tuples);
-                    return Err(String::new());
+                    return Err(EvalError::default());
                 }
                 if added && let (Some(p), Some(all)) = (prov.as_deref_mut(), all_prov) {
                     let height = 1 + ex
@@ -291,7 +291,7 @@ impl Engine {
         let stored: usize = self.rels.iter().map(Relation::len).sum();
         let max_tuples = self.options.limits.max_tuples;
         for steps in &rule.variants {
-            let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), String> {
+            let mut emit = |ex: &mut Exec<'_>, env: &mut Vec<Value>| -> Result<(), EvalError> {
                 tuple.clear();
                 for e in &rule.head {
                     tuple.push(eval::eval(e, env)?);
@@ -304,7 +304,7 @@ impl Engine {
                     // rather than after the iteration (its pending set could exhaust memory).
                     if stored + pending.len() > max_tuples {
                         ex.stop = Some(Stop::Tuples);
-                        return Err(String::new());
+                        return Err(EvalError::default());
                     }
                     if want_prov {
                         provs.push((rule.id as u32, ex.trail.clone().into_boxed_slice()));

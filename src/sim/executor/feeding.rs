@@ -271,13 +271,13 @@ impl<'a> WallRun<'a> {
     }
 
     /// Waits until `piece` touches the sensor. Err: why it did not arrive.
-    pub(super) fn await_piece(&mut self, piece: &ScenePiece) -> Result<(), String> {
+    pub(super) fn await_piece(&mut self, piece: &ScenePiece) -> Result<(), NotFed> {
         let c1 = &self.cell.conveyor1;
         if c1.speed <= 0.0 || self.cell.conveyor2.speed <= 0.0 {
-            return Err("a conveyor does not run (speed 0)".into());
+            return Err(NotFed::BeltsStopped);
         }
         if !self.on_belts.contains(&piece.id) && !self.queue.iter().any(|p| p.id == piece.id) {
-            return Err("it is not on the conveyors".into());
+            return Err(NotFed::NotOnBelts);
         }
         // Everything still ahead of it on conveyor 1 plus both belts, at conveyor 1's speed.
         let ahead: f64 = self
@@ -300,7 +300,9 @@ impl<'a> WallRun<'a> {
                 .iter()
                 .find(|id| **id != piece.id && self.on_belts.contains(*id));
             if let (Some(other), false) = (other, self.phys.belts.running) {
-                return Err(format!("{other} reached the sensor before it"));
+                return Err(NotFed::Overtaken {
+                    other: other.clone(),
+                });
             }
             if self.t - start > limit {
                 let where_ = self
@@ -311,7 +313,7 @@ impl<'a> WallRun<'a> {
                         format!(" (it is at x {:.3}, y {:.3}, z {:.3} m)", v.x, v.y, v.z)
                     })
                     .unwrap_or_default();
-                return Err(format!("it did not arrive within {limit:.0} s{where_}"));
+                return Err(NotFed::TimedOut { limit, where_ });
             }
             self.tick();
         }
@@ -324,6 +326,20 @@ impl<'a> WallRun<'a> {
         self.queue.retain(|p| p.id != id);
         self.start_belts(id);
     }
+}
+
+/// Why a piece did not arrive at the touch sensor (`await_piece`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(super) enum NotFed {
+    #[error("a conveyor does not run (speed 0)")]
+    BeltsStopped,
+    #[error("it is not on the conveyors")]
+    NotOnBelts,
+    #[error("{other} reached the sensor before it")]
+    Overtaken { other: String },
+    /// `where_`: where the piece is, as ` (it is at x …, y …, z … m)`, or empty.
+    #[error("it did not arrive within {limit:.0} s{where_}")]
+    TimedOut { limit: f64, where_: String },
 }
 
 /// Half the extent of a piece along a direction.

@@ -6,6 +6,7 @@ use crate::cell::{Arrangement, Hold, IkFailure};
 use crate::sim::motion::LinearMove;
 use crate::sim::physics::GRAVITY;
 use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
+use crate::sim::record::Op;
 use crate::sim::record::{IkRecord, Refusal, RefusalKind, RobotStep, StepFor};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
@@ -62,14 +63,15 @@ impl<'a> WallRun<'a> {
             self.record.grip_failed.push((piece.id.clone(), why));
             return;
         }
-        let start = self.begin(&piece.id, "feed", &[]);
+        let start = self.begin(&piece.id, Op::Feed, &[]);
         self.record.program.push(RobotStep::AwaitPart);
         let fed = self.await_piece(piece);
-        self.end(&piece.id, "feed", start);
+        self.end(&piece.id, Op::Feed, start);
         if let Err(why) = fed {
-            self.record
-                .not_fed
-                .push((piece.id.clone(), Refusal::new(RefusalKind::NotFed, why)));
+            self.record.not_fed.push((
+                piece.id.clone(),
+                Refusal::new(RefusalKind::NotFed, why.to_string()),
+            ));
             self.take_off(&piece.id);
             return;
         }
@@ -113,7 +115,7 @@ impl<'a> WallRun<'a> {
                 return;
             }
         };
-        for (op, margin) in [("pick", plan.pick_margin), ("place", plan.place_margin)] {
+        for (op, margin) in [(Op::Pick, plan.pick_margin), (Op::Place, plan.place_margin)] {
             self.record.ik.push(IkRecord {
                 piece: piece.id.clone(),
                 op,
@@ -124,7 +126,7 @@ impl<'a> WallRun<'a> {
         let id = piece.id.as_str();
 
         // Pick: approach above, descend, close the jaws, lift.
-        let start = self.begin(id, "pick", &[]);
+        let start = self.begin(id, Op::Pick, &[]);
         // The approach must not touch the piece either; the descent and grip may.
         if let Some(current) = &mut self.current {
             current.2.clear();
@@ -140,8 +142,8 @@ impl<'a> WallRun<'a> {
                 )
             })
         {
-            self.record_line_failure(piece, "pick", failure);
-            self.end(id, "pick", start);
+            self.record_line_failure(piece, Op::Pick, failure);
+            self.end(id, Op::Pick, start);
             self.take_off(id);
             return;
         }
@@ -159,7 +161,7 @@ impl<'a> WallRun<'a> {
                 ),
                 &grip,
             )
-            .map_err(|f| self.record_line_failure(piece, "pick", f))
+            .map_err(|f| self.record_line_failure(piece, Op::Pick, f))
             .is_ok();
         let tool = self.cell.robot_base * self.cell.robot.fk_tip(&self.q);
         let body = self.phys.lumber_pose(id).unwrap_or(piece.spawn);
@@ -182,7 +184,7 @@ impl<'a> WallRun<'a> {
                 ),
                 &grip,
             );
-            self.end(id, "pick", start);
+            self.end(id, Op::Pick, start);
             self.record.grip_failed.push((
                 id.to_string(),
                 Refusal::new(
@@ -218,14 +220,14 @@ impl<'a> WallRun<'a> {
                     ),
                     &grip,
                 )
-                .map_err(|f| self.record_line_failure(piece, "pick", f))
+                .map_err(|f| self.record_line_failure(piece, Op::Pick, f))
                 .is_ok();
         self.on_belts.remove(id);
         self.start_belts(id);
-        self.end(id, "pick", start);
+        self.end(id, Op::Pick, start);
 
         // Move above the target: the carriage to its place position, then the arm.
-        let start = self.begin(id, "move", &[]);
+        let start = self.begin(id, Op::Move, &[]);
         let carried = if ok {
             self.move_carriage(plan.carriage_place, &grip, &[])
         } else {
@@ -256,19 +258,19 @@ impl<'a> WallRun<'a> {
         {
             // No way to the target with the piece: the arm lets go where it is and the piece
             // is taken out of the cell.
-            self.record_line_failure(piece, "place", failure);
+            self.record_line_failure(piece, Op::Place, failure);
             self.phys.set_jaws(None);
             self.record.program.push(RobotStep::Release);
             self.phys.detach(id);
             self.held = None;
-            self.end(id, "move", start);
+            self.end(id, Op::Move, start);
             self.take_off(id);
             return;
         }
-        self.end(id, "move", start);
+        self.end(id, Op::Move, start);
 
         // Place: descend, open, release, retract.
-        let start = self.begin(id, "place", &[]);
+        let start = self.begin(id, Op::Place, &[]);
         let above_place = raise(&place, CLEARANCE);
         let release = raise(&place, RELEASE_GAP);
         let ok = ok
@@ -282,7 +284,7 @@ impl<'a> WallRun<'a> {
                     ),
                     &grip,
                 )
-                .map_err(|f| self.record_line_failure(piece, "place", f))
+                .map_err(|f| self.record_line_failure(piece, Op::Place, f))
                 .is_ok();
         if ok {
             self.record_grip(piece, &grip);
@@ -292,8 +294,8 @@ impl<'a> WallRun<'a> {
         self.held = None;
         self.record.program.push(RobotStep::Release);
         self.dwell(self.cell.motion.release_dwell);
-        self.end(id, "place", start);
-        let start = self.begin(id, "retract", &[]);
+        self.end(id, Op::Place, start);
+        let start = self.begin(id, Op::Retract, &[]);
         let _ = self.run_line(
             &LinearMove::new(
                 release,
@@ -303,7 +305,7 @@ impl<'a> WallRun<'a> {
             ),
             &grip,
         );
-        self.end(id, "retract", start);
+        self.end(id, Op::Retract, start);
         if ok {
             // Settled on the fixture: from now on the fixture holds it.
             self.phys.clamp(id);
@@ -361,7 +363,7 @@ impl<'a> WallRun<'a> {
 
     /// A straight move of a framing that failed on the way: recorded against the piece, so
     /// that it is not placed without a reason.
-    fn record_line_failure(&mut self, piece: &ScenePiece, op: &'static str, failure: IkFailure) {
+    fn record_line_failure(&mut self, piece: &ScenePiece, op: Op, failure: IkFailure) {
         self.record.ik.push(IkRecord {
             piece: piece.id.clone(),
             op,
@@ -487,17 +489,17 @@ impl<'a> WallRun<'a> {
     /// (a box fits its target four ways) whose pick and place poses the arm reaches, preferring
     /// a tool pointing down, poses clear of other bodies and short joint travel. Err: the
     /// operation and failure of the closest miss.
-    fn plan_framing(&self, piece: &ScenePiece) -> Result<FramingPlan, (&'static str, IkFailure)> {
+    fn plan_framing(&self, piece: &ScenePiece) -> Result<FramingPlan, (Op, IkFailure)> {
         let grip = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
         let body = self.phys.lumber_pose(&piece.id).unwrap_or(piece.spawn);
         let along = self.cell.conveyor2.direction();
         let mut best: Option<(f64, FramingPlan)> = None;
-        let mut miss: Option<(f64, &'static str, IkFailure)> = None;
+        let mut miss: Option<(f64, Op, IkFailure)> = None;
         let mut note_miss = |op, f: IkFailure| {
             // A grip whose pick fails got less far than one whose place fails: report the
             // place miss when there is one (a long plate's middle may lie beyond reach on the
             // belt, but that is not why it cannot be framed).
-            let score = failure_score(&f) + if op == "pick" { 100.0 } else { 0.0 };
+            let score = failure_score(&f) + if op == Op::Pick { 100.0 } else { 0.0 };
             if miss.as_ref().is_none_or(|m| score < m.0) {
                 miss = Some((score, op, f));
             }
@@ -526,19 +528,19 @@ impl<'a> WallRun<'a> {
                             self.cell.carriage(),
                             &[(pick, grip), (raise(&pick, CLEARANCE), grip)],
                         )
-                        .map_err(|f| ("pick", f))?;
+                        .map_err(|f| (Op::Pick, f))?;
                     let carriage_place = self
                         .carriage_for(
                             carriage_pick,
                             &[(place, grip), (raise(&place, CLEARANCE), grip)],
                         )
-                        .map_err(|f| ("place", f))?;
+                        .map_err(|f| (Op::Place, f))?;
                     let at_pick = self.cell_at(carriage_pick);
                     let at_place = self.cell_at(carriage_place);
                     // The pick and place poses themselves first: when one is out of the arm's
                     // range, that (not its approach above) is the miss to report.
-                    solve(&at_pick, &pick, &grip, &self.q).map_err(|f| ("pick", f))?;
-                    solve(&at_place, &place, &grip, &self.q).map_err(|f| ("place", f))?;
+                    solve(&at_pick, &pick, &grip, &self.q).map_err(|f| (Op::Pick, f))?;
+                    solve(&at_place, &place, &grip, &self.q).map_err(|f| (Op::Place, f))?;
                     // Descents on a branch that exists all the way down.
                     let (q_above_pick, q_pick) = continuous_line(
                         &at_pick,
@@ -548,7 +550,7 @@ impl<'a> WallRun<'a> {
                         &grip,
                         LINE_SAMPLES,
                     )
-                    .map_err(|f| ("pick", f))?;
+                    .map_err(|f| (Op::Pick, f))?;
                     let (q_above_place, q_place) = continuous_line(
                         &at_place,
                         &q_above_pick,
@@ -557,7 +559,7 @@ impl<'a> WallRun<'a> {
                         &grip,
                         LINE_SAMPLES,
                     )
-                    .map_err(|f| ("place", f))?;
+                    .map_err(|f| (Op::Place, f))?;
                     // A reachable pose that collides: the closest kind of miss, named by the
                     // pose it is at (a short piece's front gripper may meet the end stop at
                     // the pick).
@@ -565,14 +567,14 @@ impl<'a> WallRun<'a> {
                     let half = piece.size.map(|v| v / 2.0);
                     let held = Some((piece.id.as_str(), &held_in_tool, half));
                     if let Some((a, b)) = touches(&self.phys, &at_place, &q_place, held, &[], 0.0) {
-                        return Err(("place", IkFailure::AllSolutionsCollide { pair: [a, b] }));
+                        return Err((Op::Place, IkFailure::AllSolutionsCollide { pair: [a, b] }));
                     }
                     if let Some((a, b)) =
                         touches(&self.phys, &at_pick, &q_pick, None, &[&piece.id], 0.0)
                     {
-                        return Err(("pick", IkFailure::AllSolutionsCollide { pair: [a, b] }));
+                        return Err((Op::Pick, IkFailure::AllSolutionsCollide { pair: [a, b] }));
                     }
-                    Ok::<_, (&'static str, IkFailure)>(FramingPlan {
+                    Ok::<_, (Op, IkFailure)>(FramingPlan {
                         pick_body: body,
                         pick_margin: reach_margin(&at_pick, &pick, &grip),
                         place_margin: reach_margin(&at_place, &place, &grip),
@@ -604,7 +606,7 @@ impl<'a> WallRun<'a> {
         match (best, miss) {
             (Some((_, plan)), _) => Ok(plan),
             (None, Some((_, op, f))) => Err((op, f)),
-            (None, None) => Err(("place", IkFailure::InvalidPose)),
+            (None, None) => Err((Op::Place, IkFailure::InvalidPose)),
         }
     }
 }

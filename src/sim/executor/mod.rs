@@ -24,7 +24,7 @@ use super::SimOptions;
 use super::motion::{JointMove, LinearMove};
 use super::physics::Physics;
 use super::reach::{check_step, solve};
-use super::record::{ContactRecord, Operation, RobotStep, StepFor, WallRecord};
+use super::record::{ContactRecord, Op, Operation, RobotStep, StepFor, WallRecord};
 use crate::cell::{Cell, IkFailure};
 use crate::world::{ScenePiece, SceneWall};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
@@ -65,10 +65,10 @@ pub struct WallRun<'a> {
     q: Vec<f64>,
     held: Option<Held>,
     /// The element and operation contacts are attributed to, and bodies it may touch.
-    current: Option<(String, &'static str, Vec<String>)>,
+    current: Option<(String, Op, Vec<String>)>,
     /// Robot/fixed pairs touching at the start (a base on its floor): never reported.
     resting: BTreeSet<(String, String)>,
-    contacts: BTreeMap<(String, &'static str, String, String), (f64, f64)>,
+    contacts: BTreeMap<(String, Op, String, String), (f64, f64)>,
     /// Pieces not yet put on conveyor 1, in order.
     queue: VecDeque<&'a ScenePiece>,
     /// Pieces on the belts (spawned, not yet picked or removed).
@@ -345,7 +345,7 @@ impl<'a> WallRun<'a> {
         self.plies.get(id).map_or(id, |(lead, _)| lead.as_str())
     }
 
-    fn begin(&mut self, piece: &str, op: &'static str, may_touch: &[&str]) -> f64 {
+    fn begin(&mut self, piece: &str, op: Op, may_touch: &[&str]) -> f64 {
         let mut allowed: Vec<String> = may_touch
             .iter()
             .map(|p| format!("piece {}", self.body(p)))
@@ -355,7 +355,7 @@ impl<'a> WallRun<'a> {
         self.t
     }
 
-    fn end(&mut self, piece: &str, op: &'static str, start: f64) {
+    fn end(&mut self, piece: &str, op: Op, start: f64) {
         self.record.operations.push(Operation {
             piece: piece.to_string(),
             op,
@@ -371,7 +371,7 @@ impl<'a> WallRun<'a> {
         };
         // While the robot waits for a piece it stands still: what it touches does not change
         // (a contact it is still in is recorded by the next operation).
-        if *op == "feed" {
+        if *op == Op::Feed {
             return;
         }
         let held = self.held.as_ref().map(|h| h.id.as_str());
@@ -381,7 +381,7 @@ impl<'a> WallRun<'a> {
             }
             let entry = self
                 .contacts
-                .entry((piece.clone(), op, a, b))
+                .entry((piece.clone(), *op, a, b))
                 .or_insert((self.t, depth));
             entry.1 = entry.1.max(depth);
         }

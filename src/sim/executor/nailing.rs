@@ -8,6 +8,7 @@ use crate::cell::IkFailure;
 use crate::cell::tcp_poses::{nail_lines, nail_pose, nail_rolls, retreat};
 use crate::sim::motion::LinearMove;
 use crate::sim::reach::{continuous_line_where, touches};
+use crate::sim::record::Op;
 use crate::sim::record::{NailOutcome, NailRecord, RobotStep, StepFor, failure_columns};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
@@ -92,7 +93,7 @@ impl<'a> WallRun<'a> {
                 Ok(chosen) => chosen,
                 Err((start, failure)) => {
                     if let Some(start) = start {
-                        self.end(&plate, "nail", start);
+                        self.end(&plate, Op::Nail, start);
                     }
                     let (kind, what, value, limit) = failure_columns(&failure);
                     self.skip_nail(nail, kind, &what, value, limit, failure.to_string());
@@ -129,7 +130,7 @@ impl<'a> WallRun<'a> {
                 ),
                 &nail_tcp,
             );
-            self.end(&plate, "nail", start);
+            self.end(&plate, Op::Nail, start);
             if reached {
                 self.record.nails.push(NailRecord {
                     plate: nail.plate.clone(),
@@ -243,7 +244,7 @@ impl<'a> WallRun<'a> {
                     // Go to the approach pose; where no way leads there, try the next
                     // pose (a few at most: each costs the planner's budget).
                     let begun = *start.get_or_insert_with(|| {
-                        self.begin(&nail.plate, "nail", &[nail.member.as_str()])
+                        self.begin(&nail.plate, Op::Nail, &[nail.member.as_str()])
                     });
                     let mut way = self.move_to_approach(s, &q_back, &nail_tcp);
                     if way.is_err() && !lifted {

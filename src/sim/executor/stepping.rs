@@ -19,6 +19,7 @@
 use super::{CONTACT_TOLERANCE, WallRun};
 use crate::sim::Stepping;
 use crate::sim::physics::Watch;
+use crate::sim::record::Op;
 use nalgebra::Isometry3;
 
 /// Lumber slower than this is at rest (m/s, rad/s).
@@ -349,9 +350,9 @@ impl<'a> WallRun<'a> {
 /// records any: contacts are recorded in operations other than waiting for a piece (as
 /// `step`). A clearance measurement leaves out those that cannot move: touching them changes
 /// nothing until the operation changes.
-fn watched<'c>(current: &'c Option<(String, &'static str, Vec<String>)>) -> Option<&'c [String]> {
+fn watched(current: &Option<(String, Op, Vec<String>)>) -> Option<&[String]> {
     match current {
-        Some((_, op, allowed)) if *op != "feed" => Some(allowed),
+        Some((_, op, allowed)) if *op != Op::Feed => Some(allowed),
         _ => None,
     }
 }

@@ -1,9 +1,9 @@
 //! Writer state and the geometry entities it shares: points, directions, placements,
 //! profiles and representation maps, cached so equal entities are written once.
 use super::options::WriteOptions;
-use crate::synth::guid;
+use crate::ifc::guid;
+use crate::step::text::{Real, RealList, Ref, StepWriter, string};
 use crate::synth::layout::{Vec3, WallLayout};
-use crate::synth::step_text::{Real, RealList, Ref, StepWriter, string};
 use std::collections::BTreeMap;
 
 /// Writer state: the entity stream, shared entities and caches.

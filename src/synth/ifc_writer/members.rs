@@ -3,8 +3,8 @@
 use super::ctx::{Ctx, snap, wall_local_dir};
 use super::options::{PlacementBase, ProductKind, Schema, product_kind};
 use super::truth_rows::{PlaceNames, truth_member};
+use crate::step::text::{Real, Ref, RefList, string};
 use crate::synth::layout::{Piece, Vec3, WallLayout};
-use crate::synth::step_text::{Real, Ref, RefList, string};
 use crate::synth::truth::TruthMember;
 
 /// Where a wall's products are placed.

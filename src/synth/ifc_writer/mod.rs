@@ -13,9 +13,9 @@ mod truth_rows;
 
 pub use options::{Grouping, PlacementBase, ProductClasses, Schema, WriteOptions, WrittenModel};
 
+use crate::step::text::{Real, Ref, RefList, StepWriter, string};
 use crate::synth::error::SynthError;
 use crate::synth::layout::Layout;
-use crate::synth::step_text::{Real, Ref, RefList, StepWriter, string};
 use crate::synth::units::LengthUnit;
 use ctx::Ctx;
 use spatial::write_building;

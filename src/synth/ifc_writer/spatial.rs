@@ -5,9 +5,9 @@ use super::ctx::Ctx;
 use super::members::{WallPlacement, write_mapped_wall, write_piece_products};
 use super::options::{Grouping, PlacementBase, ProductClasses, Schema};
 use super::truth_rows::{PlaceNames, truth_wall};
+use crate::step::text::{Real, Ref, RefList, string};
 use crate::synth::error::SynthError;
 use crate::synth::layout::{BuildingLayout, StoreyLayout, Vec3, WallLayout};
-use crate::synth::step_text::{Real, Ref, RefList, string};
 use crate::synth::truth::{TruthMember, TruthWall};
 
 /// Building, storeys, walls and their relationships; returns the IfcBuilding.

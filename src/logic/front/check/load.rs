@@ -2,6 +2,7 @@
 //! a root folder, cycles refused), into items for the checker.
 
 use super::super::ast::*;
+use super::super::confine::Refusal;
 use super::super::diag::{Diagnostic, Diagnostics, Source};
 use super::super::lex::lex;
 use super::super::parse::{Item, Parser};
@@ -56,7 +57,7 @@ impl<'f> Loader<'f> {
     }
 
     /// The folder `.include`s of a top-level source in `dir` must stay in.
-    fn top_level_root(&self, dir: &Path) -> Result<PathBuf, String> {
+    fn top_level_root(&self, dir: &Path) -> Result<PathBuf, Refusal> {
         let root = self.include_root.as_deref().unwrap_or(dir);
         super::super::confine::canonical_root(root)
     }
@@ -69,7 +70,7 @@ impl<'f> Loader<'f> {
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let root = self
             .top_level_root(&dir)
-            .map_err(|m| Self::file_error(path, m, "check the path"))?;
+            .map_err(|m| Self::file_error(path, m.0, "check the path"))?;
         self.roots.push(root);
         let r = self.read_and_load(path, None);
         self.roots.pop();

@@ -1,16 +1,19 @@
-//! What every run starts from: the model and the cell reasoned, the walls placed on the
-//! assembly surface, the scene and the plan, with long walls cut into the panels the cell
-//! builds (`frame::panelize`).
+//! What every run starts from: the model and the cell reasoned once, the walls placed on
+//! the assembly surface (the placement search between the passes of that one run), the
+//! scene and the plan, with long walls cut into the panels the cell builds
+//! (`frame::panelize`, which reasons the panelized model once more).
 
-use super::SimError;
 use crate::cell::{Cell, PanelMode};
+use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::panelize::panelize;
-use crate::frame::placement::add_placement_facts;
+use crate::frame::placement::reason_placing;
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, RuleEngine, cell_facts, model_facts, reason};
+use crate::frame::{Facts, RuleEngine, RuleLimits, cell_facts, model_facts};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
+use crate::sim::{SimError, SimOptions, check_options};
 use crate::world::Scene;
+use std::collections::BTreeSet;
 
 /// A model and cell reasoned for a run.
 pub struct Prepared {
@@ -23,6 +26,9 @@ pub struct Prepared {
     /// The model cut into panels, when the plan split a wall: the model every stage after
     /// the split ran on (cut plates and added studs are its pieces).
     pub panelized: Option<Model>,
+    /// The plan of the model's own walls, each with its panels, when the plan split a wall
+    /// (otherwise `plan` is that plan).
+    pub model_plan: Option<Plan>,
 }
 
 /// Reasons `model` in `cell` for a run.
@@ -31,12 +37,14 @@ pub fn prepare(
     model_name: &str,
     cell: &Cell,
     engine: &RuleEngine,
+    limits: &RuleLimits,
 ) -> Result<Prepared, SimError> {
     prepare_facts(
         model,
         model_name,
         cell,
         engine,
+        limits,
         whole_facts(model, cell),
         &|f| f,
     )
@@ -56,11 +64,11 @@ pub fn prepare_facts(
     model_name: &str,
     cell: &Cell,
     engine: &RuleEngine,
-    mut facts: Facts,
+    limits: &RuleLimits,
+    facts: Facts,
     restrict: &dyn Fn(Facts) -> Facts,
 ) -> Result<Prepared, SimError> {
-    add_placement_facts(&mut facts, cell, engine)?;
-    let reasoned = reason(&facts, engine, false)?;
+    let (reasoned, facts) = reason_placing(facts, cell, engine, None, limits)?;
     let plan = Plan::from_reasoned(model, &reasoned);
     let Some(cut) = panelize(model, &plan) else {
         let scene = Scene::build(model_name, model, cell, &reasoned)?;
@@ -69,6 +77,7 @@ pub fn prepare_facts(
             scene,
             plan,
             panelized: None,
+            model_plan: None,
         });
     };
     // The panels are walls that fit: the second pass splits nothing.
@@ -76,9 +85,8 @@ pub fn prepare_facts(
     whole_panels.panel_mode = PanelMode::Off;
     let mut facts = whole_facts(&cut.model, &whole_panels);
     facts.extend(cut.facts);
-    let mut facts = restrict(facts);
-    add_placement_facts(&mut facts, &whole_panels, engine)?;
-    let reasoned = reason(&facts, engine, false)?;
+    let facts = restrict(facts);
+    let (reasoned, facts) = reason_placing(facts, &whole_panels, engine, None, limits)?;
     let mut panels = Plan::from_reasoned(&cut.model, &reasoned);
     panels.name_after_panels(&plan);
     // What the split said about the whole walls (limits dropped, panels over a limit).
@@ -91,5 +99,45 @@ pub fn prepare_facts(
         scene,
         plan: panels,
         panelized: Some(cut.model),
+        model_plan: Some(plan),
     })
+}
+
+/// A run prepared for the walls `options.walls` names. Walls named by their key pieces (as
+/// `wall_of` names them) are planned from their spatial containers' facts alone (no rule
+/// relates pieces of two containers, see `frame::containers`), so one wall of a big model
+/// costs its storey's reasoning, not the model's; their records are those `simulate` gives.
+pub fn prepare_named_walls(
+    model: &Model,
+    cell: &Cell,
+    options: &SimOptions,
+    limits: &RuleLimits,
+) -> Result<Prepared, SimError> {
+    check_options(options)?;
+    let facts = whole_facts(model, cell);
+    // A wall named otherwise (by name, or by no piece) keeps the whole model.
+    let mut containers = BTreeSet::new();
+    let mut each_in_one = !options.walls.is_empty();
+    for wall in &options.walls {
+        let of_wall = containers_of(&facts, &BTreeSet::from([wall.as_str()]));
+        each_in_one &= !of_wall.is_empty();
+        containers.extend(of_wall);
+    }
+    let restrict = |facts: Facts| {
+        if each_in_one {
+            restrict_to_containers(&facts, &containers)
+        } else {
+            facts
+        }
+    };
+    let facts = restrict(facts);
+    prepare_facts(
+        model,
+        "model",
+        cell,
+        &options.engine,
+        limits,
+        facts,
+        &restrict,
+    )
 }
