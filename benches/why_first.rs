@@ -50,7 +50,7 @@ fn main() {
     let whole = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let now = Run::new(&model, &cell, &options)
-        .wall_facts()
+        .wall_facts(None)
         .map(|(facts, _)| facts)
         .expect("one-storey run");
     let alone = start.elapsed().as_secs_f64();

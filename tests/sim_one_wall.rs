@@ -85,7 +85,7 @@ fn one_wall_from_its_storey_gives_the_facts_of_a_whole_model_run() {
         .expect("whole-model run")
         .facts;
     let alone = Run::new(&model, &cell, &options)
-        .wall_facts()
+        .wall_facts(None)
         .map(|(facts, _)| facts)
         .expect("one-wall run");
     assert!(
@@ -112,7 +112,7 @@ fn an_unknown_wall_is_an_error_naming_it() {
         ..SimOptions::default()
     };
     let err = Run::new(&model, &cell, &options)
-        .wall_facts()
+        .wall_facts(None)
         .expect_err("an unknown wall is an error");
     assert!(err.to_string().contains("no such wall"), "{err}");
 }

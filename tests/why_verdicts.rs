@@ -46,7 +46,7 @@ fn facts(model: &Model, sim: bool) -> Facts {
         };
         facts.extend(
             Run::new(model, &cell, &options)
-                .wall_facts()
+                .wall_facts(None)
                 .map(|(facts, _)| facts)
                 .expect("W1 simulates"),
         );

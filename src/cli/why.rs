@@ -82,12 +82,14 @@ struct Simulated {
 /// Adds the executor's facts of the walls of the pieces in `ids` (each wall
 /// simulated once, then cached), unless `--no-simulate`. A wall the rules split is simulated
 /// panel by panel on the model cut into panels: `facts` become that model's (the element's
-/// containers), and the model is returned, for the explanation to name its pieces.
+/// containers), and the model is returned, for the explanation to name its pieces. `whole`, when
+/// the caller has them, are the model's and the cell's facts (not built again).
 fn simulate_walls(
     c: &Common,
     model: &framewright::ifc::Model,
     cell: &framewright::cell::Cell,
     facts: &mut framewright::frame::Facts,
+    whole: Option<&framewright::frame::Facts>,
     ids: &[String],
 ) -> Result<(Vec<Simulated>, Option<framewright::ifc::Model>), Failure> {
     if c.no_simulate {
@@ -118,8 +120,15 @@ fn simulate_walls(
             .flatten()
             .map(|p| p.id.clone())
             .collect();
-        let whole = whole_facts(model, cell);
-        let keep = containers_of(&whole, &pieces.iter().map(String::as_str).collect());
+        let built;
+        let whole = match whole {
+            Some(facts) => facts,
+            None => {
+                built = whole_facts(model, cell);
+                &built
+            }
+        };
+        let keep = containers_of(whole, &pieces.iter().map(String::as_str).collect());
         let restrict = |f: framewright::frame::Facts| restrict_to_containers(&f, &keep);
         let limits = super::rule_limits()?;
         let prepared = prepare_facts(
@@ -128,7 +137,7 @@ fn simulate_walls(
             cell,
             &base,
             &limits,
-            restrict(whole),
+            restrict_to_containers(whole, &keep),
             &restrict,
         )?;
         *facts = prepared.facts;
@@ -154,7 +163,7 @@ fn simulate_walls(
         let (sim, counts) = Run::new(model, cell, &options)
             .limits(super::rule_limits()?)
             .cache(cache.as_ref())
-            .wall_facts()?;
+            .wall_facts(whole)?;
         facts.extend(sim);
         out.push(Simulated {
             wall,
@@ -200,9 +209,9 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     let c = &args.common;
     c.check_simulation()?;
     let (base, user_files) = rules_in_force(&c.inputs.rules_dir, &c.rules)?;
-    let (model, cell, facts) = load_model_facts(&args.model, &c.inputs)?;
+    let (model, cell, whole) = load_model_facts(&args.model, &c.inputs)?;
     // The whole model's plan names walls and panels as every other command does.
-    let (plan, _) = plan_of(facts.clone(), &cell, &base, &model)?;
+    let (plan, _) = plan_of(whole.clone(), &cell, &base, &model)?;
     // A panel, a plate segment or an added stud: not a piece of the model but of the plan.
     if panel_why::names_a_panel_part(&args.id) && resolve_element(&model, &args.id).is_err() {
         let answer = panel_why::why(&plan, &cell, &args.id).ok_or_else(|| {
@@ -217,10 +226,16 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     // and the rules run over them alone.
     let pieces = resolve_element(&model, &args.id).map_err(failure)?;
     let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
-    let mut facts = restrict_to_containers(&facts, &containers_of(&facts, &ids));
+    let mut facts = restrict_to_containers(&whole, &containers_of(&whole, &ids));
     add_placement_facts(&mut facts, &cell, &base)?;
-    let (mut simulated, panelized) =
-        simulate_walls(c, &model, &cell, &mut facts, std::slice::from_ref(&args.id))?;
+    let (mut simulated, panelized) = simulate_walls(
+        c,
+        &model,
+        &cell,
+        &mut facts,
+        Some(&whole),
+        std::slice::from_ref(&args.id),
+    )?;
     let names = panels_by_piece(&plan);
     for s in &mut simulated {
         s.label = names.get(&s.wall).map(PanelOf::label);
@@ -290,7 +305,7 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     }
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs, &base)?;
     let ids = piece_ids_in(&model, &args.tuple);
-    let (_, panelized) = simulate_walls(c, &model, &cell, &mut facts, &ids)?;
+    let (_, panelized) = simulate_walls(c, &model, &cell, &mut facts, None, &ids)?;
     let ctx = Context {
         model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,

@@ -107,19 +107,29 @@ pub fn prepare_facts(
 /// `wall_of` names them) are planned from their spatial containers' facts alone (no rule
 /// relates pieces of two containers, see `frame::containers`), so one wall of a big model
 /// costs its storey's reasoning, not the model's; their records are those `simulate` gives.
+/// `whole`, when given, are the model's and the cell's facts (`whole_facts`) the caller built
+/// already.
 pub fn prepare_named_walls(
     model: &Model,
     cell: &Cell,
     options: &SimOptions,
     limits: &RuleLimits,
+    whole: Option<&Facts>,
 ) -> Result<Prepared, SimError> {
     check_options(options)?;
-    let facts = whole_facts(model, cell);
+    let built;
+    let facts = match whole {
+        Some(facts) => facts,
+        None => {
+            built = whole_facts(model, cell);
+            &built
+        }
+    };
     // A wall named otherwise (by name, or by no piece) keeps the whole model.
     let mut containers = BTreeSet::new();
     let mut each_in_one = !options.walls.is_empty();
     for wall in &options.walls {
-        let of_wall = containers_of(&facts, &BTreeSet::from([wall.as_str()]));
+        let of_wall = containers_of(facts, &BTreeSet::from([wall.as_str()]));
         each_in_one &= !of_wall.is_empty();
         containers.extend(of_wall);
     }
@@ -130,7 +140,11 @@ pub fn prepare_named_walls(
             facts
         }
     };
-    let facts = restrict(facts);
+    let facts = if each_in_one {
+        restrict_to_containers(facts, &containers)
+    } else {
+        facts.clone()
+    };
     prepare_facts(
         model,
         "model",

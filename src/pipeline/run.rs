@@ -151,9 +151,11 @@ impl<'a> Run<'a> {
     /// from its wall's), each wall's record read from the cache under the key `simulate`
     /// gives it, else simulated and stored: one cache, one key, so `why` after `simulate` (or
     /// the other way round) simulates nothing again. The walls are planned from their
-    /// containers alone (`prepare_named_walls`).
-    pub fn wall_facts(&self) -> Result<(Facts, CacheCounts), SimError> {
-        let prepared = prepare_named_walls(self.model, self.cell, self.options, &self.limits)?;
+    /// containers alone (`prepare_named_walls`). `whole`, when given, are the model's and the
+    /// cell's facts (`whole_facts`), so they are not built again.
+    pub fn wall_facts(&self, whole: Option<&Facts>) -> Result<(Facts, CacheCounts), SimError> {
+        let prepared =
+            prepare_named_walls(self.model, self.cell, self.options, &self.limits, whole)?;
         let walls = self.keyed(&prepared)?;
         let (records, counts) = self.records(&prepared, &walls)?;
         Ok((records_facts(&records), counts))
