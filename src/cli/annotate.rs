@@ -64,7 +64,7 @@ pub fn run(args: AnnotateArgs) -> CmdResult {
         (model, model_plan.unwrap_or(plan), Some(verdicts))
     } else {
         let (model, cell, facts) = load_model_facts(&args.model, inputs)?;
-        let (reasoned, _) = reason_placing(facts, &cell, &engine, None, &super::rule_limits()?)?;
+        let (reasoned, _) = reason_placing(facts, &cell, &engine, &super::rule_limits()?)?;
         let plan = Plan::from_reasoned(&model, &reasoned);
         (model, plan, None)
     };

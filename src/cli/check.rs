@@ -188,7 +188,7 @@ pub fn run(args: CheckArgs) -> CmdResult {
         return report(&args, &model, &cell.name, &findings);
     }
     let (model, cell, facts) = load_model_facts(&args.model, &args.inputs)?;
-    let (reasoned, _) = reason_placing(facts, &cell, &base, None, &super::rule_limits()?)?;
+    let (reasoned, _) = reason_placing(facts, &cell, &base, &super::rule_limits()?)?;
     let findings = user.evaluate(&reasoned.relations)?;
     report(&args, &model, &cell.name, &findings)
 }

@@ -95,94 +95,49 @@ pub fn add_placement_facts_with(
 /// that places walls by search, each part of the model runs the rule base once, the search,
 /// and then only the rules the search's facts reach (the first pass's other relations stand).
 pub fn reason_placed(
-    facts: Facts,
+    mut facts: Facts,
     cell: &Cell,
     engine: &RuleEngine,
     selected: &[&str],
     limits: &RuleLimits,
 ) -> Result<Reasoned, FrameError> {
-    Ok(place_and_reason(facts, cell, engine, Some(selected), limits, Keep::Reasoned)?.0)
-}
-
-/// `reason_placed` for a caller that reasons again later over the same facts and more (a
-/// run's verdicts over its records): the facts come back with the placement facts added, as
-/// `add_placement_facts` adds them. `selected` None asks for every relation the rule base
-/// derives: the typed runner, which reads a fixed set, cannot give them, so the search then
-/// reads a first pass cut down to what it needs (`FIRST_PASS`) and the whole rule base runs
-/// once after it.
-pub fn reason_placing(
-    facts: Facts,
-    cell: &Cell,
-    engine: &RuleEngine,
-    selected: Option<&[&str]>,
-    limits: &RuleLimits,
-) -> Result<(Reasoned, Facts), FrameError> {
-    place_and_reason(facts, cell, engine, selected, limits, Keep::Facts)
-}
-
-/// Whether the caller needs the placed facts back.
-#[derive(PartialEq, Eq)]
-enum Keep {
-    Reasoned,
-    Facts,
-}
-
-fn place_and_reason(
-    mut facts: Facts,
-    cell: &Cell,
-    engine: &RuleEngine,
-    selected: Option<&[&str]>,
-    limits: &RuleLimits,
-    keep: Keep,
-) -> Result<(Reasoned, Facts), FrameError> {
     let typed = matches!(engine, RuleEngine::Compiled)
         && facts.tuples.keys().all(|k| builtin::INPUTS.contains(k))
-        && selected.is_some_and(|s| s.iter().all(|w| builtin::OUTPUTS.contains(w)));
+        && selected.iter().all(|w| builtin::OUTPUTS.contains(w));
     let OffsetX::Auto { min, max } = cell.assembly.offset_x else {
-        let reasoned = reason_within(&facts, engine, false, selected, limits)?;
-        return Ok((reasoned, facts));
+        return reason_within(&facts, engine, false, Some(selected), limits);
     };
     if !typed {
         add_placement_facts(&mut facts, cell, engine)?;
-        let reasoned = reason_within(&facts, engine, false, selected, limits)?;
-        return Ok((reasoned, facts));
+        return reason_within(&facts, engine, false, Some(selected), limits);
     }
     super::count_run(true);
     let memo = SearchMemo::default();
     let options = SearchOptions::default();
-    let found: Mutex<Vec<Facts>> = Mutex::default();
-    let place = |first: &Relations| {
-        if keep == Keep::Reasoned {
-            return placement_relations(cell, first, (min, max), &options, &memo);
-        }
-        let part = placement_part_facts(cell, first, (min, max), &options, &memo);
-        let relations = part.relations();
-        found.lock().unwrap_or_else(|e| e.into_inner()).push(part);
-        relations
-    };
-    let (parts, facts) = match keep {
-        Keep::Reasoned => (facts.into_by_container(), Facts::default()),
-        Keep::Facts => (facts.by_container(), facts),
-    };
-    let relations = reason_compiled_placing(parts, selected, limits, Some(&place))?;
+    let place = |first: &Relations| placement_relations(cell, first, (min, max), &options, &memo);
+    let parts = facts.into_by_container();
+    let relations = reason_compiled_placing(parts, Some(selected), limits, Some(&place))?;
     let reasoned = Reasoned {
         relations,
         engine: None,
     };
     limits.check_walls(reasoned.get("wall").len() as u64)?;
-    let mut facts = facts;
-    if keep == Keep::Facts {
-        // The parts searched in parallel: sorted, the facts come in one order every run.
-        let mut placed = Facts::default();
-        for part in found.into_inner().unwrap_or_else(|e| e.into_inner()) {
-            placed.extend(part);
-        }
-        for tuples in placed.tuples.values_mut() {
-            tuples.sort_by(|a, b| a.0.cmp(&b.0));
-            tuples.dedup_by(|a, b| a.0 == b.0);
-        }
-        facts.extend(placed);
-    }
+    Ok(reasoned)
+}
+
+/// Every relation of the rule base with the walls placed as the cell says, and the facts with
+/// the placement facts added (a run reasons its verdicts over them and its records later): the
+/// search reads a first pass cut down to what it needs (`FIRST_PASS`), then the whole rule base
+/// runs once. (The typed runner, which fuses the two in `reason_placed`, reads a fixed set of
+/// relations, not all of them.)
+pub fn reason_placing(
+    mut facts: Facts,
+    cell: &Cell,
+    engine: &RuleEngine,
+    limits: &RuleLimits,
+) -> Result<(Reasoned, Facts), FrameError> {
+    add_placement_facts(&mut facts, cell, engine)?;
+    let reasoned = reason_within(&facts, engine, false, None, limits)?;
     Ok((reasoned, facts))
 }
 
@@ -310,26 +265,6 @@ pub(crate) fn placement_relations(
         tuples.dedup();
     }
     relations
-}
-
-/// The placement facts of one part with their origins, as `placement_facts` states them.
-fn placement_part_facts(
-    cell: &Cell,
-    first: &Relations,
-    range: (f64, f64),
-    options: &SearchOptions,
-    memo: &SearchMemo,
-) -> Facts {
-    let mut facts = Facts::default();
-    search(
-        cell,
-        first,
-        range,
-        options,
-        memo,
-        &mut |relation, tuple, origin| facts.add(relation, tuple, Origin::Event(origin())),
-    );
-    facts
 }
 
 /// Runs the search and hands each fact to `add` (relation, tuple, and how to say where it

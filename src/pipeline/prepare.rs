@@ -68,7 +68,7 @@ pub fn prepare_facts(
     facts: Facts,
     restrict: &dyn Fn(Facts) -> Facts,
 ) -> Result<Prepared, SimError> {
-    let (reasoned, facts) = reason_placing(facts, cell, engine, None, limits)?;
+    let (reasoned, facts) = reason_placing(facts, cell, engine, limits)?;
     let plan = Plan::from_reasoned(model, &reasoned);
     let Some(cut) = panelize(model, &plan) else {
         let scene = Scene::build(model_name, model, cell, &reasoned)?;
@@ -86,7 +86,7 @@ pub fn prepare_facts(
     let mut facts = whole_facts(&cut.model, &whole_panels);
     facts.extend(cut.facts);
     let facts = restrict(facts);
-    let (reasoned, facts) = reason_placing(facts, &whole_panels, engine, None, limits)?;
+    let (reasoned, facts) = reason_placing(facts, &whole_panels, engine, limits)?;
     let mut panels = Plan::from_reasoned(&cut.model, &reasoned);
     panels.name_after_panels(&plan);
     // What the split said about the whole walls (limits dropped, panels over a limit).

@@ -127,7 +127,7 @@ impl Scene {
         let mut facts = model_facts(model, &ContactOptions::default());
         facts.extend(cell_facts(cell));
         let limits = crate::frame::RuleLimits::default();
-        Ok(crate::frame::placement::reason_placing(facts, cell, engine, None, &limits)?.0)
+        Ok(crate::frame::placement::reason_placing(facts, cell, engine, &limits)?.0)
     }
 
     /// Opens a model, reasons with the built-in (compiled) rules and builds its scene.
