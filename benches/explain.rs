@@ -16,7 +16,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use framewright::cell::Cell;
 use framewright::explain::why::{Context, why};
 use framewright::frame::plan::Plan;
-use framewright::frame::{Facts, RuleEngine, cell_facts, model_facts, reason};
+use framewright::frame::{Ask, Facts, RuleEngine, cell_facts, model_facts};
 use framewright::ifc::Model;
 use framewright::user_rules::UserRules;
 use std::hint::black_box;
@@ -39,14 +39,17 @@ fn inputs(path: &Path, cell: &Cell) -> (Model, Facts) {
 
 fn plan(path: &Path, cell: &Cell) -> usize {
     let (model, facts) = inputs(path, cell);
-    let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");
+    let reasoned = Ask::new(&RuleEngine::Compiled)
+        .over(&facts)
+        .expect("reason");
     Plan::from_reasoned(&model, &reasoned).walls.len()
 }
 
 /// What `check` does before the user rules: read, facts, compiled rule base.
 fn reason_only(path: &Path, cell: &Cell) -> usize {
     let (_, facts) = inputs(path, cell);
-    reason(&facts, &RuleEngine::Compiled, false)
+    Ask::new(&RuleEngine::Compiled)
+        .over(&facts)
         .expect("reason")
         .get("wall")
         .len()
@@ -55,7 +58,9 @@ fn reason_only(path: &Path, cell: &Cell) -> usize {
 fn check(path: &Path, cell: &Cell, files: &[PathBuf]) -> usize {
     let rules = UserRules::load(files, &RuleEngine::Compiled).expect("rules");
     let (_, facts) = inputs(path, cell);
-    let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");
+    let reasoned = Ask::new(&RuleEngine::Compiled)
+        .over(&facts)
+        .expect("reason");
     let findings = rules.evaluate(&reasoned.relations).expect("evaluate");
     findings.violations.len() + findings.warnings.len()
 }
@@ -67,6 +72,7 @@ fn explain(path: &Path, cell: &Cell, id: &str) -> usize {
         facts: &facts,
         base: &RuleEngine::Compiled,
         user_files: &[],
+        limits: framewright::frame::RuleLimits::default(),
     };
     why(&ctx, id).expect("why")[0].verdicts.len()
 }

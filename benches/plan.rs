@@ -5,7 +5,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, model_facts, reason};
+use framewright::frame::{Ask, RuleEngine, model_facts};
 use framewright::ifc::Model;
 use framewright::synth::{WriteOptions, building, models, write_ifc};
 use std::hint::black_box;
@@ -14,7 +14,9 @@ use std::path::Path;
 fn plan(path: &Path) -> usize {
     let model = Model::open(path).expect("read");
     let facts = model_facts(&model, &Default::default());
-    let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");
+    let reasoned = Ask::new(&RuleEngine::Compiled)
+        .over(&facts)
+        .expect("reason");
     Plan::from_reasoned(&model, &reasoned).walls.len()
 }
 

@@ -14,13 +14,11 @@
 //! time only the current path; `PLAN_SCALE_SIZES=1` also prints the largest relations).
 //! Peak memory: `/usr/bin/time -v framewright plan --json M.ifc`.
 
-use framewright::cache::{Cache, reason_plan_cached_with};
+use framewright::cache::Cache;
 use framewright::cell::Cell;
-use framewright::frame::placement::{SearchOptions, add_placement_facts_with, reason_placed};
+use framewright::frame::placement::SearchOptions;
 use framewright::frame::plan::Plan;
-use framewright::frame::{
-    RuleEngine, RuleLimits, cell_facts, model_facts, reason, reason_selected,
-};
+use framewright::frame::{Ask, RuleEngine, RuleLimits, cell_facts, model_facts};
 use framewright::ifc::Model;
 use framewright::report::plan::PlanReport;
 use framewright::synth::building::{BlockSpec, blocks};
@@ -68,25 +66,18 @@ fn plan(path: &Path, reasoning: &Reasoning, label: &str) -> (f64, blake3::Hash) 
     lap("facts and contacts");
     let reasoned = match reasoning {
         Reasoning::Fused => {
-            let limits = RuleLimits::default();
-            let placed = reason_placed(
-                facts,
-                &cell,
-                &RuleEngine::Compiled,
-                Plan::RELATIONS,
-                &limits,
-            );
-            placed.expect("reason")
+            let ask = Ask::new(&RuleEngine::Compiled).only(Plan::RELATIONS);
+            ask.placed(facts, &cell).expect("reason")
         }
         Reasoning::TwoPasses(options) => {
-            add_placement_facts_with(&mut facts, &cell, &RuleEngine::Compiled, options)
-                .expect("placement");
+            let ask = Ask::new(&RuleEngine::Compiled).search(*options);
+            ask.place(&mut facts, &cell).expect("placement");
             lap("placement search (1st pass)");
             // The oldest path (`every_offset`) converted every relation; `plan` reads its own.
             if options.every_offset {
-                reason(&facts, &RuleEngine::Compiled, false)
+                ask.over(&facts)
             } else {
-                reason_selected(&facts, &RuleEngine::Compiled, Plan::RELATIONS)
+                ask.only(Plan::RELATIONS).over(&facts)
             }
             .expect("reason")
         }
@@ -121,10 +112,16 @@ fn plan_cached(path: &Path, cache: &Cache, label: &str) -> (f64, blake3::Hash) {
     let mut facts = model_facts(&model, &Default::default());
     facts.extend(cell_facts(&cell));
     let limits = RuleLimits::default();
-    let (_reasoned, counts, plan) = reason_plan_cached_with(facts, &cell, cache, &limits, |r| {
-        Plan::from_relations(&model, r)
-    })
+    let planned = framewright::pipeline::plan(
+        &model,
+        &cell,
+        facts,
+        &RuleEngine::Compiled,
+        limits,
+        Some(cache),
+    )
     .expect("reason");
+    let (plan, counts) = (planned.plan, planned.cache.expect("counts"));
     let json = json_digest(&PlanReport::new(&model, &plan));
     let seconds = start.elapsed().as_secs_f64();
     eprintln!(

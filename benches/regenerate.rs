@@ -13,11 +13,9 @@
 //! `-- --plan-only` for the plan rows alone).
 //! The full simulation is not repeated: this is a bench command, not a criterion sample.
 
-use framewright::cache::{Cache, reason_plan_cached};
+use framewright::cache::Cache;
 use framewright::cell::Cell;
-use framewright::frame::placement::add_placement_facts;
-use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, RuleLimits, cell_facts, model_facts, reason_selected};
+use framewright::frame::{RuleEngine, RuleLimits, cell_facts, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::pipeline::Run;
@@ -101,19 +99,16 @@ fn plan_rows(path: &Path, edited_path: &Path, dir: &Path, cell: &Cell) {
         let m = Model::open(model_path).unwrap();
         let mut facts = model_facts(&m, &ContactOptions::default());
         facts.extend(cell_facts(cell));
-        let (reasoned, counts) = match cache {
-            Some(cache) => {
-                let (r, c) =
-                    reason_plan_cached(facts, cell, cache, &RuleLimits::default()).unwrap();
-                (r, Some(c))
-            }
-            None => {
-                add_placement_facts(&mut facts, cell, &RuleEngine::Compiled).unwrap();
-                let r = reason_selected(&facts, &RuleEngine::Compiled, Plan::RELATIONS).unwrap();
-                (r, None)
-            }
-        };
-        let plan = Plan::from_reasoned(&m, &reasoned);
+        let planned = framewright::pipeline::plan(
+            &m,
+            cell,
+            facts,
+            &RuleEngine::Compiled,
+            RuleLimits::default(),
+            cache,
+        )
+        .unwrap();
+        let (plan, counts) = (planned.plan, planned.cache);
         (t.elapsed().as_secs_f64(), plan.walls.len(), counts)
     };
     let plan_cache = Cache::new(dir.join("plan-cache"));

@@ -94,12 +94,14 @@ fn bench(c: &mut Criterion) {
 
 /// Every 7th wall of the model's plan, by id.
 fn wall_sample(model: &Model, cell: &Cell) -> Vec<String> {
-    use framewright::frame::{RuleEngine, cell_facts, model_facts, placement, plan, reason};
+    use framewright::frame::{Ask, RuleEngine, cell_facts, model_facts, plan};
     let mut facts = model_facts(model, &framewright::geom::ContactOptions::default());
     facts.extend(cell_facts(cell));
     let engine = RuleEngine::Compiled;
-    placement::add_placement_facts(&mut facts, cell, &engine).expect("placement");
-    let reasoned = reason(&facts, &engine, false).expect("reasoning");
+    Ask::new(&engine)
+        .place(&mut facts, cell)
+        .expect("placement");
+    let reasoned = Ask::new(&engine).over(&facts).expect("reasoning");
     plan::Plan::from_reasoned(model, &reasoned)
         .walls
         .iter()

@@ -37,6 +37,7 @@ fn main() {
         facts: &facts,
         base: &base,
         user_files: &[],
+        limits: framewright::frame::RuleLimits::default(),
     };
     let walls = element_walls(&ctx, &id).expect("the element's wall");
     let options = SimOptions {

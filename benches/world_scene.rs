@@ -3,8 +3,9 @@
 //! ../shared when present.
 use criterion::{Criterion, criterion_group, criterion_main};
 use framewright::cell::Cell;
-use framewright::frame::RuleEngine;
+use framewright::frame::{Ask, RuleEngine};
 use framewright::ifc::Model;
+use framewright::pipeline::whole_facts;
 use framewright::world::{Scene, json, wbt};
 use std::hint::black_box;
 use std::path::Path;
@@ -25,10 +26,16 @@ fn world(c: &mut Criterion) {
     group.measurement_time(Duration::from_secs(8));
     for (name, path) in models {
         let model = Model::open(&path).expect("model opens");
-        let reasoned = Scene::reason(&model, &cell, &RuleEngine::Compiled).expect("reasons");
+        let reasoned = Ask::new(&RuleEngine::Compiled)
+            .placed(whole_facts(&model, &cell), &cell)
+            .expect("reasons");
         let scene = Scene::build(name, &model, &cell, &reasoned).expect("scene");
         group.bench_function(format!("{name}: reason (compiled rules)"), |b| {
-            b.iter(|| Scene::reason(black_box(&model), &cell, &RuleEngine::Compiled).unwrap())
+            b.iter(|| {
+                Ask::new(&RuleEngine::Compiled)
+                    .placed(whole_facts(black_box(&model), &cell), &cell)
+                    .unwrap()
+            })
         });
         group.bench_function(format!("{name}: scene from relations"), |b| {
             b.iter(|| Scene::build(name, black_box(&model), &cell, &reasoned).unwrap())

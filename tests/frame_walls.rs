@@ -4,7 +4,7 @@
 mod common;
 
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, model_facts, reason};
+use framewright::frame::{Ask, RuleEngine, model_facts};
 use framewright::ifc::Model;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
@@ -36,12 +36,9 @@ fn walls_and_frames_match_the_truth() {
         let truth: Value =
             serde_json::from_str(&std::fs::read_to_string(&truth_path).unwrap()).unwrap();
         let model = Model::open(&ifc).unwrap();
-        let reasoned = reason(
-            &model_facts(&model, &Default::default()),
-            &RuleEngine::Compiled,
-            false,
-        )
-        .unwrap();
+        let reasoned = Ask::new(&RuleEngine::Compiled)
+            .over(&model_facts(&model, &Default::default()))
+            .unwrap();
         let plan = Plan::from_reasoned(&model, &reasoned);
         let name = ifc.file_name().unwrap().to_string_lossy().to_string();
 
@@ -121,12 +118,9 @@ fn no_framing_means_no_walls_and_a_reason() {
         return;
     };
     let model = Model::open(&path).unwrap();
-    let reasoned = reason(
-        &model_facts(&model, &Default::default()),
-        &RuleEngine::Compiled,
-        false,
-    )
-    .unwrap();
+    let reasoned = Ask::new(&RuleEngine::Compiled)
+        .over(&model_facts(&model, &Default::default()))
+        .unwrap();
     let plan = Plan::from_reasoned(&model, &reasoned);
     assert!(plan.walls.is_empty());
     assert_eq!(plan.warnings.len(), 1);

@@ -6,11 +6,9 @@
 //! twice (the path before), on TM1–TM3 and a generated multi-storey model with grouped
 //! walls, openings and property sets, with both shipped cells.
 use framewright::cell::Cell;
-use framewright::frame::placement::{SearchOptions, add_placement_facts_with, reason_placed};
+use framewright::frame::placement::SearchOptions;
 use framewright::frame::plan::Plan;
-use framewright::frame::{
-    Reasoned, RuleEngine, RuleLimits, cell_facts, model_facts, reason, reason_selected,
-};
+use framewright::frame::{Ask, Reasoned, RuleEngine, cell_facts, model_facts};
 use framewright::ifc::Model;
 use framewright::logic::compiled::builtin;
 use framewright::report::plan::PlanReport;
@@ -34,26 +32,22 @@ fn plan_json(model: &Model, cell: &Cell, path: Route) -> Vec<u8> {
     let mut facts = model_facts(model, &Default::default());
     facts.extend(cell_facts(cell));
     let reasoned = match path {
-        Route::Fused => reason_placed(
-            facts,
-            cell,
-            &RuleEngine::Compiled,
-            Plan::RELATIONS,
-            &RuleLimits::default(),
-        )
-        .expect("reason"),
+        Route::Fused => Ask::new(&RuleEngine::Compiled)
+            .only(Plan::RELATIONS)
+            .placed(facts, cell)
+            .expect("reason"),
         Route::Before | Route::TwoPasses => {
             let before = matches!(path, Route::Before);
             let options = SearchOptions {
                 every_offset: before,
                 ..SearchOptions::default()
             };
-            add_placement_facts_with(&mut facts, cell, &RuleEngine::Compiled, &options)
-                .expect("search");
+            let ask = Ask::new(&RuleEngine::Compiled).search(options);
+            ask.place(&mut facts, cell).expect("search");
             if before {
-                reason(&facts, &RuleEngine::Compiled, false)
+                ask.over(&facts)
             } else {
-                reason_selected(&facts, &RuleEngine::Compiled, Plan::RELATIONS)
+                ask.only(Plan::RELATIONS).over(&facts)
             }
             .expect("reason")
         }
@@ -123,23 +117,12 @@ fn every_relation(model: &Model, cell: &Cell, fused: bool) -> Reasoned {
         facts.tuples.keys().all(|k| builtin::INPUTS.contains(k)),
         "the model's and the cell's facts are all typed inputs, so the fused path applies"
     );
+    let ask = Ask::new(&RuleEngine::Compiled).only(builtin::OUTPUTS);
     let mut reasoned = if fused {
-        reason_placed(
-            facts,
-            cell,
-            &RuleEngine::Compiled,
-            builtin::OUTPUTS,
-            &RuleLimits::default(),
-        )
+        ask.placed(facts, cell)
     } else {
-        add_placement_facts_with(
-            &mut facts,
-            cell,
-            &RuleEngine::Compiled,
-            &SearchOptions::default(),
-        )
-        .expect("search");
-        reason_selected(&facts, &RuleEngine::Compiled, builtin::OUTPUTS)
+        ask.place(&mut facts, cell).expect("search");
+        ask.over(&facts)
     }
     .expect("reason");
     for tuples in reasoned.relations.values_mut() {

@@ -2,9 +2,9 @@
 //! model of repeated walls (where sharing happens) the plan must be the one every target
 //! searching on its own gives, byte for byte.
 use framewright::cell::Cell;
-use framewright::frame::placement::{SearchOptions, add_placement_facts_with};
+use framewright::frame::placement::SearchOptions;
 use framewright::frame::plan::Plan;
-use framewright::frame::{RuleEngine, cell_facts, model_facts, reason};
+use framewright::frame::{Ask, RuleEngine, cell_facts, model_facts};
 use framewright::ifc::Model;
 use framewright::report::plan::PlanReport;
 use framewright::synth::building::{BlockSpec, blocks};
@@ -17,8 +17,13 @@ fn plan_json(model: &Model, cell: &Cell, share: bool) -> Vec<u8> {
         share_equal_poses: share,
         ..SearchOptions::default()
     };
-    add_placement_facts_with(&mut facts, cell, &RuleEngine::Compiled, &options).expect("search");
-    let reasoned = reason(&facts, &RuleEngine::Compiled, false).expect("reason");
+    Ask::new(&RuleEngine::Compiled)
+        .search(options)
+        .place(&mut facts, cell)
+        .expect("search");
+    let reasoned = Ask::new(&RuleEngine::Compiled)
+        .over(&facts)
+        .expect("reason");
     let mut json = Vec::new();
     PlanReport::new(model, &Plan::from_reasoned(model, &reasoned))
         .write_json(&mut json)

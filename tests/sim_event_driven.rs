@@ -208,8 +208,10 @@ fn twenty_walls_of_the_three_storey_model_agree() {
         framewright::frame::model_facts(&model, &framewright::geom::ContactOptions::default());
     facts.extend(framewright::frame::cell_facts(&cell));
     let engine = framewright::frame::RuleEngine::Compiled;
-    framewright::frame::placement::add_placement_facts(&mut facts, &cell, &engine).unwrap();
-    let reasoned = framewright::frame::reason(&facts, &engine, false).unwrap();
+    framewright::frame::Ask::new(&engine)
+        .place(&mut facts, &cell)
+        .unwrap();
+    let reasoned = framewright::frame::Ask::new(&engine).over(&facts).unwrap();
     let plan = framewright::frame::plan::Plan::from_reasoned(&model, &reasoned);
     let walls: Vec<String> = plan.walls.iter().step_by(7).map(|w| w.id.clone()).collect();
     assert!(walls.len() >= 20, "{} walls sampled", walls.len());

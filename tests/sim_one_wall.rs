@@ -5,7 +5,7 @@
 mod common;
 
 use framewright::cell::Cell;
-use framewright::frame::{cell_facts, model_facts, reason};
+use framewright::frame::{Ask, cell_facts, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::pipeline::{Run, simulate};
@@ -36,7 +36,9 @@ fn two_storey_block(dir: &Path) -> Model {
 fn upper_storey_walls(model: &Model, cell: &Cell) -> Vec<(usize, String)> {
     let mut facts = model_facts(model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
-    let reasoned = reason(&facts, &Default::default(), false).expect("reasoning");
+    let reasoned = Ask::new(&Default::default())
+        .over(&facts)
+        .expect("reasoning");
     let containers: Vec<String> = {
         let mut c: Vec<String> = facts.tuples["piece_container"]
             .iter()

@@ -62,6 +62,7 @@ fn explain(sim: bool) -> (Vec<WhyReport>, Model) {
         facts: &f,
         base: &RuleEngine::Compiled,
         user_files: &[],
+        limits: framewright::frame::RuleLimits::default(),
     };
     (why(&ctx, TOP_PLATE).unwrap(), model)
 }
@@ -311,6 +312,7 @@ fn ids_resolve_by_piece_id_global_id_and_entity() {
         facts: &f,
         base: &RuleEngine::Compiled,
         user_files: &[],
+        limits: framewright::frame::RuleLimits::default(),
     };
     let by_entity = why(&ctx, "#174").unwrap();
     let by_item = why(&ctx, "#171").unwrap();

@@ -4,9 +4,10 @@
 mod common;
 
 use framewright::cell::Cell;
-use framewright::frame::RuleEngine;
 use framewright::frame::facts::density_of;
+use framewright::frame::{Ask, RuleEngine};
 use framewright::ifc::Model;
+use framewright::pipeline::whole_facts;
 use framewright::world::{Scene, ScenePiece, json};
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
@@ -31,7 +32,9 @@ fn example(name: &str) -> PathBuf {
 /// The expected queue, computed here from the reasoned inputs of the order: walls by the file
 /// position of their first piece, then each wall's pieces by assembly_rank.
 fn expected_order(model: &Model, cell: &Cell) -> Vec<String> {
-    let r = Scene::reason(model, cell, &RuleEngine::Compiled).unwrap();
+    let r = Ask::new(&RuleEngine::Compiled)
+        .placed(whole_facts(model, cell), cell)
+        .unwrap();
     let index: BTreeMap<String, i64> = r
         .get("piece_index")
         .iter()
@@ -258,7 +261,9 @@ fn masses_are_volume_times_density() {
 fn framing_targets_of_the_scene_are_the_rule_targets() {
     let cell = pinned(Cell::load("study-abb").unwrap());
     let model = Model::open(example("tm1.ifc")).unwrap();
-    let r = Scene::reason(&model, &cell, &RuleEngine::Compiled).unwrap();
+    let r = Ask::new(&RuleEngine::Compiled)
+        .placed(whole_facts(&model, &cell), &cell)
+        .unwrap();
     let targets = framewright::world::framing_targets(&r).unwrap();
     let s = Scene::build("tm1.ifc", &model, &cell, &r).unwrap();
     assert_eq!(targets.len(), 1);
@@ -287,8 +292,12 @@ fn json_is_byte_identical_across_runs() {
 fn engines_agree_on_the_scene() {
     let cell = pinned(Cell::load("study-abb").unwrap());
     let model = Model::open(example("tm3.ifc")).unwrap();
-    let compiled = Scene::reason(&model, &cell, &RuleEngine::Compiled).unwrap();
-    let interpreted = Scene::reason(&model, &cell, &RuleEngine::Interpreted).unwrap();
+    let compiled = Ask::new(&RuleEngine::Compiled)
+        .placed(whole_facts(&model, &cell), &cell)
+        .unwrap();
+    let interpreted = Ask::new(&RuleEngine::Interpreted)
+        .placed(whole_facts(&model, &cell), &cell)
+        .unwrap();
     let a = json::to_json(&Scene::build("tm3.ifc", &model, &cell, &compiled).unwrap());
     let b = json::to_json(&Scene::build("tm3.ifc", &model, &cell, &interpreted).unwrap());
     assert_eq!(a, b);

@@ -4,7 +4,7 @@
 //! with `cell::Assembly::wall_to_cell`.
 
 use framewright::cell::{Cell, Orientation};
-use framewright::frame::{RuleEngine, cell_facts, model_facts, reason};
+use framewright::frame::{Ask, RuleEngine, cell_facts, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::logic::Value;
@@ -47,7 +47,7 @@ fn targets(
     let model = Model::open(root().join("examples/models").join(model)).unwrap();
     let mut facts = model_facts(&model, &ContactOptions::default());
     facts.extend(cell_facts(cell));
-    let r = reason(&facts, &engine, false).unwrap();
+    let r = Ask::new(&engine).over(&facts).unwrap();
     let pieces = r
         .get("framing_target")
         .iter()
@@ -137,7 +137,7 @@ fn wall_frames_agree_with_the_cell_module() {
             assert!(pieces.len() >= 60, "{cell_name}: {} targets", pieces.len());
             let model = Model::open(root().join("examples/models/tm3.ifc")).unwrap();
             let facts = model_facts(&model, &ContactOptions::default());
-            let r = reason(&facts, &RuleEngine::Compiled, false).unwrap();
+            let r = Ask::new(&RuleEngine::Compiled).over(&facts).unwrap();
             for t in r.get("wall_size") {
                 let w = sym(&t[0]);
                 let (l, h) = (t[1].as_float().unwrap(), t[2].as_float().unwrap());

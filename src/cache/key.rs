@@ -137,7 +137,7 @@ pub fn wall_key(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::{cell_facts, model_facts, reason};
+    use crate::frame::{Ask, cell_facts, model_facts};
     use crate::geom::ContactOptions;
     use crate::ifc::Model;
     use crate::world::Scene;
@@ -148,8 +148,7 @@ mod tests {
         let model = Model::open(&path).unwrap();
         let mut facts = model_facts(&model, &ContactOptions::default());
         facts.extend(cell_facts(cell));
-        crate::frame::placement::add_placement_facts(&mut facts, cell, &options.engine).unwrap();
-        let reasoned = reason(&facts, &options.engine, false).unwrap();
+        let (reasoned, _) = Ask::new(&options.engine).placing(facts, cell).unwrap();
         let scene = Scene::build("tm3.ifc", &model, cell, &reasoned).unwrap();
         let plan = plan::Plan::from_reasoned(&model, &reasoned);
         plan.walls

@@ -11,7 +11,7 @@ pub mod store;
 pub mod trace_codec;
 pub mod value_codec;
 
-pub use plan::{reason_plan_cached, reason_plan_cached_with};
+pub(crate) use plan::reason_plan_cached_with;
 pub use plan_writer::PlanWriter;
 pub use sim::{CacheCounts, Need, Shard, ShardError, ShardRun};
 pub(crate) use sim::{look_up, store};

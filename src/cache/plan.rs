@@ -12,12 +12,10 @@ use super::value_codec::{Reader, Writer};
 use super::{Cache, CacheCounts, PlanWriter};
 use crate::cell::{Cell, OffsetX};
 use crate::frame::partition::{Indices, Partition};
-use crate::frame::placement::{
-    FIRST_PASS, SearchMemo, SearchOptions, placement_relations, reason_placed,
-};
+use crate::frame::placement::{FIRST_PASS, SearchMemo, SearchOptions, placement_relations};
 use crate::frame::plan::Plan;
 use crate::frame::rows::{PieceContainer, rows_of};
-use crate::frame::{Facts, FrameError, Reasoned, RuleEngine, RuleLimits};
+use crate::frame::{Ask, Facts, FrameError, Reasoned, RuleEngine, RuleLimits};
 use crate::logic::compiled::{Relations, builtin};
 use crate::logic::functors::defs::{box_centre, box_radius, dot};
 use crate::logic::value::{F64, OBox, Sym, Value, Vec3};
@@ -33,11 +31,12 @@ const MAGIC: &[u8] = b"framewright plan part 2\n";
 /// entries afterwards) instead of part by part (each part with its storey as context).
 const WHOLE_CONTAINER_SHARE: f64 = 0.25;
 
-/// `plan`'s reasoning through the cache: the same relations `reason_selected(facts,
-/// Compiled, Plan::RELATIONS)` gives after `add_placement_facts`, in the same order, and
+/// `plan`'s reasoning through the cache: the same relations `Ask::new(&Compiled)
+/// .only(Plan::RELATIONS).placed(facts, cell)` gives, in the same order, and
 /// how many walls were reasoned and how many came from the cache. `facts` are the model's
 /// and the cell's, without placement facts (the search runs per part here).
-pub fn reason_plan_cached(
+#[cfg(test)]
+pub(crate) fn reason_plan_cached(
     facts: Facts,
     cell: &Cell,
     cache: &Cache,
@@ -50,7 +49,7 @@ pub fn reason_plan_cached(
 /// `reason_plan_cached`, and `then` called on the reasoned relations (`Plan::RELATIONS`, maybe
 /// more). A first run calls it while it splits and encodes its entries, so the caller's next
 /// step (building the plan) runs beside the cache's own work.
-pub fn reason_plan_cached_with<T: Send>(
+pub(crate) fn reason_plan_cached_with<T: Send>(
     facts: Facts,
     cell: &Cell,
     cache: &Cache,
@@ -209,7 +208,10 @@ fn first_run<T: Send>(
 ) -> Result<(Reasoned, CacheCounts, T), FrameError> {
     let mut wanted: Vec<&str> = Plan::RELATIONS.to_vec();
     wanted.push(REACH);
-    let mut reasoned = reason_placed(facts, cell, &RuleEngine::Compiled, &wanted, limits)?;
+    let mut reasoned = Ask::new(&RuleEngine::Compiled)
+        .within(*limits)
+        .only(&wanted)
+        .placed(facts, cell)?;
     let relations = &reasoned.relations;
     let writer = stored.cache.plan_writer();
     let (rejected, after) = rayon::join(

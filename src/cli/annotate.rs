@@ -5,7 +5,7 @@
 use super::check::{ReasoningInputs, load_model_facts, rule_base};
 use super::{CmdResult, Failure, write_atomically};
 use framewright::bim::{AnnotateOptions, NailSize, annotate, element_verdicts};
-use framewright::frame::placement::reason_placing;
+use framewright::frame::Ask;
 use framewright::frame::plan::Plan;
 use framewright::pipeline::Run;
 use framewright::sim::{SimOptions, Simulation};
@@ -64,7 +64,9 @@ pub fn run(args: AnnotateArgs) -> CmdResult {
         (model, model_plan.unwrap_or(plan), Some(verdicts))
     } else {
         let (model, cell, facts) = load_model_facts(&args.model, inputs)?;
-        let (reasoned, _) = reason_placing(facts, &cell, &engine, &super::rule_limits()?)?;
+        let reasoned = Ask::new(&engine)
+            .within(super::rule_limits()?)
+            .placed(facts, &cell)?;
         let plan = Plan::from_reasoned(&model, &reasoned);
         (model, plan, None)
     };

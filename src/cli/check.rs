@@ -5,8 +5,7 @@
 use super::{CmdResult, Failure, print_stdout};
 use framewright::cell::{Cell, PanelMode};
 use framewright::frame::cell_facts::cell_facts;
-use framewright::frame::placement::{add_placement_facts, reason_placing};
-use framewright::frame::{Facts, RuleEngine, model_facts};
+use framewright::frame::{Ask, Facts, RuleEngine, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::pipeline::Run;
@@ -103,7 +102,9 @@ pub fn load_inputs(
     engine: &RuleEngine,
 ) -> Result<(Model, Cell, Facts), Failure> {
     let (model, cell, mut facts) = load_model_facts(model, inputs)?;
-    add_placement_facts(&mut facts, &cell, engine)?;
+    Ask::new(engine)
+        .within(super::rule_limits()?)
+        .place(&mut facts, &cell)?;
     Ok((model, cell, facts))
 }
 
@@ -188,7 +189,9 @@ pub fn run(args: CheckArgs) -> CmdResult {
         return report(&args, &model, &cell.name, &findings);
     }
     let (model, cell, facts) = load_model_facts(&args.model, &args.inputs)?;
-    let (reasoned, _) = reason_placing(facts, &cell, &base, &super::rule_limits()?)?;
+    let reasoned = Ask::new(&base)
+        .within(super::rule_limits()?)
+        .placed(facts, &cell)?;
     let findings = user.evaluate(&reasoned.relations)?;
     report(&args, &model, &cell.name, &findings)
 }

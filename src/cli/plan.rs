@@ -6,10 +6,8 @@
 use super::cache::{CacheArgs, warn_if_unwritable};
 use super::check::{ReasoningInputs, load_model_facts, rules_in_force};
 use super::{CmdResult, Failure, leave_to_exit, print_stdout, write_stdout};
-use framewright::cache::reason_plan_cached_with;
 use framewright::frame::RuleEngine;
-use framewright::frame::placement::reason_placed;
-use framewright::frame::plan::Plan;
+use framewright::pipeline::{self, Planned};
 use framewright::report::plan::PlanReport;
 use framewright::report::role_check::{RoleCheck, Truth};
 use std::path::PathBuf;
@@ -55,21 +53,11 @@ pub fn run(args: PlanArgs) -> CmdResult {
         _ => None,
     };
     let limits = super::rule_limits()?;
-    let (reasoned, counts, plan) = match &cache {
-        Some(cache) => {
-            // A first run stores its entries while the plan is built.
-            let (reasoned, counts, plan) =
-                reason_plan_cached_with(facts, &cell, cache, &limits, |relations| {
-                    Plan::from_relations(&model, relations)
-                })?;
-            (reasoned, Some(counts), plan)
-        }
-        None => {
-            let reasoned = reason_placed(facts, &cell, &engine, Plan::RELATIONS, &limits)?;
-            let plan = Plan::from_reasoned(&model, &reasoned);
-            (reasoned, None, plan)
-        }
-    };
+    let Planned {
+        reasoned,
+        plan,
+        cache: counts,
+    } = pipeline::plan(&model, &cell, facts, &engine, limits, cache.as_ref())?;
     let role_check = truth.map(|t| RoleCheck::new(&t, &model, &plan));
     let mut report = PlanReport::new(&model, &plan);
     report.cache = counts;

@@ -10,11 +10,11 @@ use framewright::explain::render::{render_answer, render_why, render_why_not};
 use framewright::explain::why::{
     Context, WhyError, element_walls_split, name_walls, resolve_element, why, why_not,
 };
+use framewright::frame::Ask;
 use framewright::frame::containers::{containers_of, restrict_to_containers};
 use framewright::frame::panel::PanelOf;
 use framewright::frame::panel_why;
 use framewright::frame::panelize::panels_by_piece;
-use framewright::frame::placement::{add_placement_facts, reason_placed};
 use framewright::frame::plan::Plan;
 use framewright::logic::compiled::Relations;
 use framewright::pipeline::{Run, prepare_facts, whole_facts};
@@ -101,6 +101,7 @@ fn simulate_walls(
         facts,
         base: &base,
         user_files: &user_files,
+        limits: super::rule_limits()?,
     };
     let mut walls = Vec::new();
     let mut split = false;
@@ -227,7 +228,9 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
     let pieces = resolve_element(&model, &args.id).map_err(failure)?;
     let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
     let mut facts = restrict_to_containers(&whole, &containers_of(&whole, &ids));
-    add_placement_facts(&mut facts, &cell, &base)?;
+    Ask::new(&base)
+        .within(super::rule_limits()?)
+        .place(&mut facts, &cell)?;
     let (mut simulated, panelized) = simulate_walls(
         c,
         &model,
@@ -245,6 +248,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         facts: &facts,
         base: &base,
         user_files: &user_files,
+        limits: super::rule_limits()?,
     };
     let mut reports = why(&ctx, &args.id).map_err(failure)?;
     name_walls(&mut reports, &names);
@@ -311,6 +315,7 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
         facts: &facts,
         base: &base,
         user_files: &user_files,
+        limits: super::rule_limits()?,
     };
     let report = why_not(&ctx, &args.tuple).map_err(failure)?;
     let text = if c.json {
@@ -333,8 +338,10 @@ fn plan_of(
     base: &framewright::frame::RuleEngine,
     model: &framewright::ifc::Model,
 ) -> Result<(Plan, Relations), Failure> {
-    let limits = super::rule_limits()?;
-    let reasoned = reason_placed(facts, cell, base, Plan::RELATIONS, &limits)?;
+    let reasoned = Ask::new(base)
+        .within(super::rule_limits()?)
+        .only(Plan::RELATIONS)
+        .placed(facts, cell)?;
     let plan = Plan::from_reasoned(model, &reasoned);
     Ok((plan, reasoned.relations))
 }

@@ -62,6 +62,8 @@ pub struct Context<'a> {
     pub facts: &'a Facts,
     pub base: &'a RuleEngine,
     pub user_files: &'a [PathBuf],
+    /// Bounds on the rule base's runs.
+    pub limits: crate::frame::RuleLimits,
 }
 
 /// The pieces an ID names: a piece id, an IFC GlobalId (all pieces of a
@@ -149,7 +151,9 @@ pub fn element_walls_split(ctx: &Context<'_>, id: &str) -> Result<(Vec<String>, 
     let pieces = resolve_element(ctx.model, id)?;
     let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
     let facts = restrict_to_containers(ctx.facts, &containers_of(ctx.facts, &ids));
-    let reasoned = crate::frame::reason(&facts, ctx.base, false)
+    let reasoned = crate::frame::Ask::new(ctx.base)
+        .within(ctx.limits)
+        .over(&facts)
         .map_err(|e| WhyError::Frame(e.to_string()))?;
     let walls: BTreeSet<String> = reasoned
         .get("wall_of")

@@ -2,6 +2,7 @@
 //! model. The compiled (ascent) engine is the normal path; the interpreter
 //! runs the same rules for `--rules-dir`, user rules and provenance.
 
+mod ask;
 pub mod cell_facts;
 pub mod containers;
 pub mod facts;
@@ -22,6 +23,7 @@ use crate::logic::{Diagnostics, Engine, LogicError, Options, Program, Value};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+pub use ask::Ask;
 pub use cell_facts::cell_facts;
 pub use facts::{Facts, model_facts};
 pub use limits::RuleLimits;
@@ -112,46 +114,6 @@ pub fn extended_program(files: &[PathBuf]) -> Result<Program, FrameError> {
         loader.load_file(f, None)?;
     }
     Ok(loader.finish()?)
-}
-
-/// Runs the rule base over the facts, within the default bounds (`reason_within` takes others).
-pub fn reason(
-    facts: &Facts,
-    engine: &RuleEngine,
-    provenance: bool,
-) -> Result<Reasoned, FrameError> {
-    reason_within(facts, engine, provenance, None, &RuleLimits::default())
-}
-
-/// Runs the rule base over the facts for a caller that reads only the named relations (the
-/// others may be missing from the result): the compiled engine then turns only those into
-/// `Value` tuples. `plan` reads `Plan::RELATIONS`. Within the default bounds.
-pub fn reason_selected(
-    facts: &Facts,
-    engine: &RuleEngine,
-    relations: &[&str],
-) -> Result<Reasoned, FrameError> {
-    reason_within(
-        facts,
-        engine,
-        false,
-        Some(relations),
-        &RuleLimits::default(),
-    )
-}
-
-/// `reason` or `reason_selected` under explicit bounds.
-pub fn reason_within(
-    facts: &Facts,
-    engine: &RuleEngine,
-    provenance: bool,
-    selected: Option<&[&str]>,
-    limits: &RuleLimits,
-) -> Result<Reasoned, FrameError> {
-    count_run(selected.is_some());
-    let reasoned = reason_unchecked(facts, engine, provenance, selected, limits)?;
-    limits.check_walls(reasoned.get("wall").len() as u64)?;
-    Ok(reasoned)
 }
 
 static WHOLE_RUNS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);

@@ -74,7 +74,7 @@ pub const CONTEXT_RELATIONS: &[&str] = &["piece_box", "piece_size", "piece_conta
 
 impl Partition {
     /// Splits the facts. Contacts between pieces of two containers are dropped, as the
-    /// container split of `frame::reason` drops them.
+    /// container split of the rule base's run (`Ask`) drops them.
     pub fn of(facts: &Facts) -> Partition {
         let mut containers: Vec<Container> = Vec::new();
         let mut container_index: FxHashMap<&str, usize> = FxHashMap::default();

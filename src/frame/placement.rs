@@ -11,13 +11,10 @@
 //! solve, at one of the rolls the executor tries. Every solution counted keeps the arm and
 //! its tool above the floor.
 
-use super::{
-    Facts, FrameError, Reasoned, RuleEngine, RuleLimits, reason_compiled_placing, reason_selected,
-    reason_within,
-};
+use super::{Facts, Reasoned};
+use crate::cell::Cell;
 use crate::cell::tcp_poses::{centre_grip, lowest_point, nail_pose, nail_rolls, retreat};
-use crate::cell::{Cell, OffsetX};
-use crate::logic::compiled::{Relations, builtin};
+use crate::logic::compiled::Relations;
 use crate::logic::{Origin, Value};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 use rustc_hash::FxHashMap;
@@ -64,82 +61,6 @@ impl Default for SearchOptions {
 /// Poses whose coordinates (m), unit-quaternion components and sizes (m) round to the same
 /// multiple of this share one search: 1 nm, far below the 1 cm step of the offsets.
 pub const SHARE_GRID: f64 = 1e-9;
-
-/// Adds the placement facts when the cell places walls automatically (a first pass of the
-/// rules gives the pieces' poses with every wall at offset 0). Nothing to add otherwise.
-pub fn add_placement_facts(
-    facts: &mut Facts,
-    cell: &Cell,
-    engine: &RuleEngine,
-) -> Result<(), FrameError> {
-    add_placement_facts_with(facts, cell, engine, &SearchOptions::default())
-}
-
-/// `add_placement_facts` with search options.
-pub fn add_placement_facts_with(
-    facts: &mut Facts,
-    cell: &Cell,
-    engine: &RuleEngine,
-    options: &SearchOptions,
-) -> Result<(), FrameError> {
-    let OffsetX::Auto { min, max } = cell.assembly.offset_x else {
-        return Ok(());
-    };
-    let first = reason_selected(facts, engine, FIRST_PASS)?;
-    facts.extend(placement_facts(cell, &first, min, max, options));
-    Ok(())
-}
-
-/// The rule base's `selected` relations with the walls placed as the cell says: what
-/// `add_placement_facts` and then `reason_within` give. With the compiled rules and a cell
-/// that places walls by search, each part of the model runs the rule base once, the search,
-/// and then only the rules the search's facts reach (the first pass's other relations stand).
-pub fn reason_placed(
-    mut facts: Facts,
-    cell: &Cell,
-    engine: &RuleEngine,
-    selected: &[&str],
-    limits: &RuleLimits,
-) -> Result<Reasoned, FrameError> {
-    let typed = matches!(engine, RuleEngine::Compiled)
-        && facts.tuples.keys().all(|k| builtin::INPUTS.contains(k))
-        && selected.iter().all(|w| builtin::OUTPUTS.contains(w));
-    let OffsetX::Auto { min, max } = cell.assembly.offset_x else {
-        return reason_within(&facts, engine, false, Some(selected), limits);
-    };
-    if !typed {
-        add_placement_facts(&mut facts, cell, engine)?;
-        return reason_within(&facts, engine, false, Some(selected), limits);
-    }
-    super::count_run(true);
-    let memo = SearchMemo::default();
-    let options = SearchOptions::default();
-    let place = |first: &Relations| placement_relations(cell, first, (min, max), &options, &memo);
-    let parts = facts.into_by_container();
-    let relations = reason_compiled_placing(parts, Some(selected), limits, Some(&place))?;
-    let reasoned = Reasoned {
-        relations,
-        engine: None,
-    };
-    limits.check_walls(reasoned.get("wall").len() as u64)?;
-    Ok(reasoned)
-}
-
-/// Every relation of the rule base with the walls placed as the cell says, and the facts with
-/// the placement facts added (a run reasons its verdicts over them and its records later): the
-/// search reads a first pass cut down to what it needs (`FIRST_PASS`), then the whole rule base
-/// runs once. (The typed runner, which fuses the two in `reason_placed`, reads a fixed set of
-/// relations, not all of them.)
-pub fn reason_placing(
-    mut facts: Facts,
-    cell: &Cell,
-    engine: &RuleEngine,
-    limits: &RuleLimits,
-) -> Result<(Reasoned, Facts), FrameError> {
-    add_placement_facts(&mut facts, cell, engine)?;
-    let reasoned = reason_within(&facts, engine, false, None, limits)?;
-    Ok((reasoned, facts))
-}
 
 /// What the search reads of the first pass.
 pub(crate) const FIRST_PASS: &[&str] = super::rule_reads::PLACEMENT_FIRST_PASS;

@@ -41,7 +41,7 @@ fn iso(v: &Value) -> Isometry3<f64> {
 }
 
 impl Plan {
-    /// The relations `from_reasoned` reads (`frame::reason_selected` returns only these).
+    /// The relations `from_reasoned` reads (`Ask::only` returns only these).
     pub const RELATIONS: &'static [&'static str] = super::rule_reads::PLAN;
 
     /// Collects the plan from the rule base's relations (missing relations give empty parts).

@@ -6,9 +6,8 @@
 use crate::cell::{Cell, PanelMode};
 use crate::frame::containers::{containers_of, restrict_to_containers};
 use crate::frame::panelize::panelize;
-use crate::frame::placement::reason_placing;
 use crate::frame::plan::Plan;
-use crate::frame::{Facts, RuleEngine, RuleLimits, cell_facts, model_facts};
+use crate::frame::{Ask, Facts, RuleEngine, RuleLimits, cell_facts, model_facts};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
 use crate::sim::{SimError, SimOptions, check_options};
@@ -68,7 +67,8 @@ pub fn prepare_facts(
     facts: Facts,
     restrict: &dyn Fn(Facts) -> Facts,
 ) -> Result<Prepared, SimError> {
-    let (reasoned, facts) = reason_placing(facts, cell, engine, limits)?;
+    let ask = Ask::new(engine).within(*limits);
+    let (reasoned, facts) = ask.placing(facts, cell)?;
     let plan = Plan::from_reasoned(model, &reasoned);
     let Some(cut) = panelize(model, &plan) else {
         let scene = Scene::build(model_name, model, cell, &reasoned)?;
@@ -86,7 +86,7 @@ pub fn prepare_facts(
     let mut facts = whole_facts(&cut.model, &whole_panels);
     facts.extend(cut.facts);
     let facts = restrict(facts);
-    let (reasoned, facts) = reason_placing(facts, &whole_panels, engine, limits)?;
+    let (reasoned, facts) = ask.placing(facts, &whole_panels)?;
     let mut panels = Plan::from_reasoned(&cut.model, &reasoned);
     panels.name_after_panels(&plan);
     // What the split said about the whole walls (limits dropped, panels over a limit).
@@ -133,18 +133,12 @@ pub fn prepare_named_walls(
         each_in_one &= !of_wall.is_empty();
         containers.extend(of_wall);
     }
-    let restrict = |facts: Facts| {
-        if each_in_one {
-            restrict_to_containers(&facts, &containers)
-        } else {
-            facts
-        }
+    // The model's facts and, when a wall is split, the panelized model's are cut alike.
+    let restrict = |facts: &Facts| -> Option<Facts> {
+        each_in_one.then(|| restrict_to_containers(facts, &containers))
     };
-    let facts = if each_in_one {
-        restrict_to_containers(facts, &containers)
-    } else {
-        facts.clone()
-    };
+    let facts = restrict(facts).unwrap_or_else(|| facts.clone());
+    let restrict = |facts: Facts| restrict(&facts).unwrap_or(facts);
     prepare_facts(
         model,
         "model",

@@ -7,7 +7,7 @@ use super::prepare::{Prepared, prepare, prepare_named_walls};
 use crate::cache::key::{build_id, wall_key};
 use crate::cache::{Cache, CacheCounts, Need, Shard, ShardRun, look_up, store};
 use crate::cell::Cell;
-use crate::frame::{Facts, RuleLimits, reason_within};
+use crate::frame::{Ask, Facts, RuleLimits};
 use crate::ifc::Model;
 use crate::sim::{
     SimError, SimOptions, Simulation, WallRecord, check_options, records_facts, run_walls,
@@ -262,7 +262,9 @@ impl<'a> Run<'a> {
         } = prepared;
         let sim_facts = records_facts(&records);
         facts.extend(sim_facts.clone());
-        let reasoned = reason_within(&facts, &self.options.engine, false, None, &self.limits)?;
+        let reasoned = Ask::new(&self.options.engine)
+            .within(self.limits)
+            .over(&facts)?;
         Ok(Simulation {
             scene,
             plan,

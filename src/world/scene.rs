@@ -6,7 +6,7 @@ use super::relations::{
     world_pieces,
 };
 use crate::cell::{Cell, Conveyor, Floor, PlacedShape, ToolTable, TouchSensor};
-use crate::frame::{Reasoned, RuleEngine, cell_facts, model_facts};
+use crate::frame::{Ask, Reasoned, RuleEngine, cell_facts, model_facts};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
 use nalgebra::Isometry3;
@@ -122,18 +122,12 @@ pub fn webots_proto(robot: &str) -> Option<(&'static str, &'static str)> {
 }
 
 impl Scene {
-    /// Facts of the model and the cell, reasoned with `engine`.
-    pub fn reason(model: &Model, cell: &Cell, engine: &RuleEngine) -> Result<Reasoned, WorldError> {
-        let mut facts = model_facts(model, &ContactOptions::default());
-        facts.extend(cell_facts(cell));
-        let limits = crate::frame::RuleLimits::default();
-        Ok(crate::frame::placement::reason_placing(facts, cell, engine, &limits)?.0)
-    }
-
     /// Opens a model, reasons with the built-in (compiled) rules and builds its scene.
     pub fn from_model_file(path: &Path, cell: &Cell) -> Result<Scene, WorldError> {
         let model = Model::open(path)?;
-        let reasoned = Scene::reason(&model, cell, &RuleEngine::Compiled)?;
+        let mut facts = model_facts(&model, &ContactOptions::default());
+        facts.extend(cell_facts(cell));
+        let reasoned = Ask::new(&RuleEngine::Compiled).placed(facts, cell)?;
         let name = path.file_name().map_or_else(
             || path.display().to_string(),
             |n| n.to_string_lossy().into_owned(),

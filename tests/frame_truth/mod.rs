@@ -6,7 +6,7 @@
 #[path = "../common/skip.rs"]
 mod skip;
 
-use framewright::frame::{Reasoned, RuleEngine, model_facts, reason};
+use framewright::frame::{Ask, Reasoned, RuleEngine, model_facts};
 use framewright::geom::ContactOptions;
 use framewright::ifc::Model;
 use framewright::logic::Value;
@@ -70,7 +70,9 @@ pub fn own_cases() -> Vec<Case> {
 pub fn reasoned(case: &Case, engine: &RuleEngine) -> Reasoned {
     let model = Model::open(&case.ifc).unwrap_or_else(|e| panic!("{}: {e}", case.name));
     let facts = model_facts(&model, &ContactOptions::default());
-    reason(&facts, engine, false).unwrap_or_else(|e| panic!("{}: {e}", case.name))
+    Ask::new(engine)
+        .over(&facts)
+        .unwrap_or_else(|e| panic!("{}: {e}", case.name))
 }
 
 pub fn sym(v: &Value) -> &str {

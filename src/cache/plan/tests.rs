@@ -1,5 +1,5 @@
 use super::*;
-use crate::frame::{cell_facts, model_facts, reason_selected};
+use crate::frame::{Ask, cell_facts, model_facts};
 use crate::geom::ContactOptions;
 use crate::ifc::Model;
 
@@ -18,8 +18,10 @@ fn the_storey_extent_check_computes_what_the_rule_derives() {
         facts.extend(cell_facts(&cell));
         let partition = Partition::of(&facts);
         let extents = Extents::of(&facts, &partition);
-        let reasoned =
-            reason_selected(&facts, &crate::frame::RuleEngine::Compiled, &[REACH]).unwrap();
+        let reasoned = Ask::new(&crate::frame::RuleEngine::Compiled)
+            .only(&[REACH])
+            .over(&facts)
+            .unwrap();
         for row in reasoned.get(REACH) {
             let c = extents.index[row[0].as_symbol().unwrap()];
             let Value::Vec3(k) = &row[1] else { panic!() };
@@ -64,8 +66,10 @@ fn facts_of(model: &Model, cell: &Cell) -> Facts {
 fn uncached(facts: &Facts, cell: &Cell) -> Relations {
     let mut facts = facts.clone();
     let engine = crate::frame::RuleEngine::Compiled;
-    crate::frame::placement::add_placement_facts(&mut facts, cell, &engine).unwrap();
-    reason_selected(&facts, &engine, Plan::RELATIONS)
+    Ask::new(&engine).place(&mut facts, cell).unwrap();
+    Ask::new(&engine)
+        .only(Plan::RELATIONS)
+        .over(&facts)
         .unwrap()
         .relations
 }
