@@ -73,6 +73,7 @@ fn explain(path: &Path, cell: &Cell, id: &str) -> usize {
         base: &RuleEngine::Compiled,
         user_files: &[],
         limits: framewright::frame::RuleLimits::default(),
+        cell: None,
     };
     why(&ctx, id).expect("why")[0].verdicts.len()
 }

@@ -38,6 +38,7 @@ fn main() {
         base: &base,
         user_files: &[],
         limits: framewright::frame::RuleLimits::default(),
+        cell: None,
     };
     let walls = element_walls(&ctx, &id).expect("the element's wall");
     let options = SimOptions {

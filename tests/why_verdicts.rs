@@ -63,6 +63,7 @@ fn explain(sim: bool) -> (Vec<WhyReport>, Model) {
         base: &RuleEngine::Compiled,
         user_files: &[],
         limits: framewright::frame::RuleLimits::default(),
+        cell: None,
     };
     (why(&ctx, TOP_PLATE).unwrap(), model)
 }
@@ -313,6 +314,7 @@ fn ids_resolve_by_piece_id_global_id_and_entity() {
         base: &RuleEngine::Compiled,
         user_files: &[],
         limits: framewright::frame::RuleLimits::default(),
+        cell: None,
     };
     let by_entity = why(&ctx, "#174").unwrap();
     let by_item = why(&ctx, "#171").unwrap();

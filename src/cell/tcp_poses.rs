@@ -5,6 +5,27 @@ use super::layout::Cell;
 use super::shapes::{PlacedShape, Shape};
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
+/// Steps of the grip point from a piece's middle towards either end (m)...
+pub const GRIP_SHIFT_STEP: f64 = 0.1;
+/// ...keeping the outer gripper this far inside the piece's end (m).
+pub const GRIP_END_MARGIN: f64 = 0.05;
+
+/// How far (m) the middle of two grippers `spacing` apart may move from the middle of a piece
+/// `length` long while both stay on it, GRIP_END_MARGIN inside its ends.
+pub fn two_gripper_reach(length: f64, spacing: f64) -> f64 {
+    (length / 2.0 - spacing / 2.0 - GRIP_END_MARGIN).max(0.0)
+}
+
+/// The shifts (m, from the piece's middle, 0 first) at which two grippers take a piece: the
+/// executor's grips, and what a remedy checks.
+pub fn two_gripper_shifts(length: f64, spacing: f64) -> Vec<f64> {
+    let furthest = two_gripper_reach(length, spacing);
+    (0..)
+        .map(|k| k as f64 * GRIP_SHIFT_STEP)
+        .take_while(|s| *s <= furthest + 1e-9)
+        .collect()
+}
+
 /// Roll angles about the nail line tried in turn (0: the flange above the nose): six fixed
 /// ones, then the one that turns the tool's x axis towards the robot's base axis through
 /// `base` (for a nail at the edge of the reach, the flange then lies nearest the shoulder).

@@ -102,6 +102,7 @@ fn simulate_walls(
         base: &base,
         user_files: &user_files,
         limits: super::rule_limits()?,
+        cell: None,
     };
     let mut walls = Vec::new();
     let mut split = false;
@@ -249,6 +250,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         base: &base,
         user_files: &user_files,
         limits: super::rule_limits()?,
+        cell: Some(&cell),
     };
     let mut reports = why(&ctx, &args.id).map_err(failure)?;
     name_walls(&mut reports, &names);
@@ -316,6 +318,7 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
         base: &base,
         user_files: &user_files,
         limits: super::rule_limits()?,
+        cell: None,
     };
     let report = why_not(&ctx, &args.tuple).map_err(failure)?;
     let text = if c.json {

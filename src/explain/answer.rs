@@ -196,6 +196,8 @@ fn cause(
         evidence: lines,
         consequences: Vec::new(),
         verdict: index,
+        remedies: Vec::new(),
+        no_remedy: Vec::new(),
     }
 }
 

@@ -85,6 +85,12 @@ pub fn render_answer(reports: &[WhyReport]) -> String {
             for q in &c.consequences {
                 let _ = writeln!(s, "  so {} {}: {}", q.count, q.kind, pairs(&q.ids));
             }
+            for m in &c.remedies {
+                let _ = writeln!(s, "  would pass: {}", m.text);
+            }
+            if !c.no_remedy.is_empty() {
+                let _ = writeln!(s, "  no remedy: {}", c.no_remedy.join("; "));
+            }
         }
         if !a.consequences.is_empty() || !a.findings.is_empty() {
             s.push('\n');

@@ -114,6 +114,10 @@ pub struct Cause {
     pub consequences: Vec<Consequence>,
     /// The verdict (index into the report's `verdicts`) whose tree explains it.
     pub verdict: usize,
+    /// Changes that make it pass, each checked where it says so (`explain::remedy`).
+    pub remedies: Vec<super::remedy::Remedy>,
+    /// What was searched for a remedy without finding one.
+    pub no_remedy: Vec<String>,
 }
 
 /// Verdicts that follow from a cause, folded.

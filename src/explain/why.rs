@@ -64,6 +64,8 @@ pub struct Context<'a> {
     pub user_files: &'a [PathBuf],
     /// Bounds on the rule base's runs.
     pub limits: crate::frame::RuleLimits,
+    /// The cell the element was simulated in: remedies are computed against it.
+    pub cell: Option<&'a crate::cell::Cell>,
 }
 
 /// The pieces an ID names: a piece id, an IFC GlobalId (all pieces of a
@@ -195,7 +197,11 @@ pub fn why(ctx: &Context<'_>, id: &str) -> Result<Vec<WhyReport>, WhyError> {
     let engine = explaining_engine(&facts, ctx.base, ctx.user_files)?;
     let mut reports = Vec::new();
     for p in pieces {
-        reports.push(why_piece(&engine, p)?);
+        let mut report = why_piece(&engine, p)?;
+        if let Some(cell) = ctx.cell {
+            super::remedy::attach(&engine, cell, &mut report)?;
+        }
+        reports.push(report);
     }
     Ok(reports)
 }

@@ -13,7 +13,9 @@
 
 use super::{Facts, Reasoned};
 use crate::cell::Cell;
-use crate::cell::tcp_poses::{centre_grip, lowest_point, nail_pose, nail_rolls, retreat};
+use crate::cell::tcp_poses::{
+    centre_grip, lowest_point, nail_pose, nail_rolls, retreat, two_gripper_shifts,
+};
 use crate::logic::compiled::Relations;
 use crate::logic::{Origin, Value};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
@@ -449,6 +451,30 @@ pub fn reaches(cell: &Cell, target: &Isometry3<f64>, size: &[f64; 3]) -> bool {
         let above = Translation3::new(0.0, 0.0, APPROACH_HEIGHT) * place;
         reached_together(cell, &[place, above], grip)
     })
+}
+
+/// The shift along the piece (m, from its middle) of the first grip at which the arm takes a
+/// piece's place pose and the pose APPROACH_HEIGHT above it: at its centre of mass first, then
+/// shifted towards either end as the executor may grip it with two grippers
+/// (`tcp_poses::two_gripper_shifts`; it may set a piece down either end first). None when no
+/// grip does.
+pub fn reached_held_at(cell: &Cell, target: &Isometry3<f64>, size: &[f64; 3]) -> Option<f64> {
+    let grip = cell.tool.tcp("grip")?;
+    let spacing = cell.tool.gripper.as_ref().map_or(0.0, |g| g.spacing);
+    let along = target.rotation * Vector3::x();
+    two_gripper_shifts(size[0], spacing)
+        .into_iter()
+        .flat_map(|s| if s > 0.0 { vec![s, -s] } else { vec![s] })
+        .find(|s| {
+            [false, true].into_iter().any(|flip| {
+                let Some(centre) = centre_grip(target, size, flip) else {
+                    return false;
+                };
+                let place = Translation3::from(along * *s) * centre;
+                let above = Translation3::new(0.0, 0.0, APPROACH_HEIGHT) * place;
+                reached_together(cell, &[place, above], grip)
+            })
+        })
 }
 
 /// Whether the nailer reaches a nail at `point` (robot frame) driven along `direction`.

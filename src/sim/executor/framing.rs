@@ -2,6 +2,7 @@
 
 use super::paths::distance;
 use super::{Held, WallRun, failure_score, raise};
+use crate::cell::tcp_poses::{GRIP_SHIFT_STEP, two_gripper_reach, two_gripper_shifts};
 use crate::cell::{Arrangement, Hold, IkFailure};
 use crate::sim::motion::LinearMove;
 use crate::sim::physics::GRAVITY;
@@ -17,10 +18,6 @@ pub(super) const CLEARANCE: f64 = 0.25;
 pub(super) const RELEASE_GAP: f64 = 0.001;
 /// A piece more than this far from where the plan expected it when the jaws close is not
 /// held (m).
-/// Steps of the grip point from a piece's middle towards its leading end (m)...
-const GRIP_SHIFT_STEP: f64 = 0.1;
-/// ...keeping the front gripper this far inside the piece's end (m).
-const GRIP_END_MARGIN: f64 = 0.05;
 /// Samples checked along a straight descent while planning.
 const LINE_SAMPLES: usize = 10;
 pub(super) const GRIP_TOLERANCE: f64 = 0.005;
@@ -645,11 +642,8 @@ fn grip_shifts(
             }
         }
         _ => {
-            let furthest = (length / 2.0 - spacing / 2.0 - GRIP_END_MARGIN).max(0.0);
-            let offsets = (0..)
-                .map(|k| k as f64 * GRIP_SHIFT_STEP)
-                .take_while(|s| *s <= furthest + 1e-9);
-            for s in offsets {
+            let furthest = two_gripper_reach(length, spacing);
+            for s in two_gripper_shifts(length, spacing) {
                 shifts.push((s, false, s > 0.0));
                 shifts.push((s, true, false));
             }
