@@ -42,7 +42,10 @@ fn plan(path: &Path, cell: &Cell) -> usize {
     let reasoned = Ask::new(&RuleEngine::Compiled)
         .over(&facts)
         .expect("reason");
-    Plan::from_reasoned(&model, &reasoned).walls.len()
+    Plan::from_reasoned(&model, &reasoned)
+        .expect("plan")
+        .walls
+        .len()
 }
 
 /// What `check` does before the user rules: read, facts, compiled rule base.

@@ -17,7 +17,10 @@ fn plan(path: &Path) -> usize {
     let reasoned = Ask::new(&RuleEngine::Compiled)
         .over(&facts)
         .expect("reason");
-    Plan::from_reasoned(&model, &reasoned).walls.len()
+    Plan::from_reasoned(&model, &reasoned)
+        .expect("plan")
+        .walls
+        .len()
 }
 
 fn benches(c: &mut Criterion) {

@@ -94,7 +94,7 @@ fn plan(path: &Path, reasoning: &Reasoning, label: &str) -> (f64, blake3::Hash) 
             eprintln!("    {name} {n}");
         }
     }
-    let plan = Plan::from_reasoned(&model, &reasoned);
+    let plan = Plan::from_reasoned(&model, &reasoned).expect("plan");
     let report = PlanReport::new(&model, &plan);
     lap("typed plan");
     let json = json_digest(&report);

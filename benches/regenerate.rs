@@ -27,7 +27,10 @@ use std::time::Instant;
 
 fn report_json(sim: &framewright::sim::Simulation, dt: f64) -> String {
     let mut out = Vec::new();
-    SimReport::new(sim, dt).write_json(&mut out).unwrap();
+    SimReport::new(sim, dt)
+        .expect("report")
+        .write_json(&mut out)
+        .unwrap();
     String::from_utf8(out).unwrap()
 }
 

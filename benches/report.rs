@@ -30,7 +30,7 @@ fn tm3(c: &mut Criterion) {
     let start = Instant::now();
     let sim = simulate(&model, &cell, &options).expect("simulation");
     let simulating = start.elapsed().as_secs_f64();
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     let input = ReportInput {
         model: &model,
         model_name: "tm3.ifc",
@@ -83,7 +83,7 @@ fn building() {
         .expect("simulation");
     let counts = counts.expect("a cached run counts");
     let simulating = start.elapsed().as_secs_f64();
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     let input = ReportInput {
         model: &model,
         model_name: "g_scale_3storey.ifc",

@@ -103,6 +103,7 @@ fn wall_sample(model: &Model, cell: &Cell) -> Vec<String> {
         .expect("placement");
     let reasoned = Ask::new(&engine).over(&facts).expect("reasoning");
     plan::Plan::from_reasoned(model, &reasoned)
+        .expect("plan")
         .walls
         .iter()
         .step_by(7)

@@ -39,7 +39,7 @@ fn walls_and_frames_match_the_truth() {
         let reasoned = Ask::new(&RuleEngine::Compiled)
             .over(&model_facts(&model, &Default::default()))
             .unwrap();
-        let plan = Plan::from_reasoned(&model, &reasoned);
+        let plan = Plan::from_reasoned(&model, &reasoned).expect("plan");
         let name = ifc.file_name().unwrap().to_string_lossy().to_string();
 
         // The partition: the same sets of pieces, whatever the walls are called.
@@ -121,7 +121,7 @@ fn no_framing_means_no_walls_and_a_reason() {
     let reasoned = Ask::new(&RuleEngine::Compiled)
         .over(&model_facts(&model, &Default::default()))
         .unwrap();
-    let plan = Plan::from_reasoned(&model, &reasoned);
+    let plan = Plan::from_reasoned(&model, &reasoned).expect("plan");
     assert!(plan.walls.is_empty());
     assert_eq!(plan.warnings.len(), 1);
     assert!(

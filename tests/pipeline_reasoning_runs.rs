@@ -29,6 +29,7 @@ fn runs_of<T>(f: impl FnOnce() -> T) -> (T, RuleBaseRuns) {
 fn json(sim: &framewright::sim::Simulation, options: &SimOptions) -> Vec<u8> {
     let mut out = Vec::new();
     SimReport::new(sim, options.dt)
+        .expect("report")
         .write_json(&mut out)
         .expect("JSON");
     out

@@ -53,7 +53,7 @@ fn plan_json(model: &Model, cell: &Cell, path: Route) -> Vec<u8> {
         }
     };
     let mut json = Vec::new();
-    PlanReport::new(model, &Plan::from_reasoned(model, &reasoned))
+    PlanReport::new(model, &Plan::from_reasoned(model, &reasoned).expect("plan"))
         .write_json(&mut json)
         .expect("json");
     json

@@ -25,7 +25,7 @@ fn plan_json(model: &Model, cell: &Cell, share: bool) -> Vec<u8> {
         .over(&facts)
         .expect("reason");
     let mut json = Vec::new();
-    PlanReport::new(model, &Plan::from_reasoned(model, &reasoned))
+    PlanReport::new(model, &Plan::from_reasoned(model, &reasoned).expect("plan"))
         .write_json(&mut json)
         .expect("json");
     json

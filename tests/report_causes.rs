@@ -30,7 +30,7 @@ fn run(name: &str, walls: &[&str]) -> (framewright::sim::Simulation, SimReport) 
     cell.set_offset_x("0.531").unwrap();
     cell.arrangement = framewright::cell::Arrangement::EndToEnd;
     let sim = simulate(&model, &cell, &options).expect("simulation runs");
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     (sim, report)
 }
 

@@ -44,7 +44,7 @@ fn run(path: &Path) -> Run {
     let model = Model::open(path).expect("model");
     let cell = Cell::load("study-abb").unwrap();
     let sim = simulate(&model, &cell, &SimOptions::default()).expect("simulation runs");
-    let report = SimReport::new(&sim, SimOptions::default().dt);
+    let report = SimReport::new(&sim, SimOptions::default().dt).expect("report");
     let name = path.file_name().unwrap().to_string_lossy().into_owned();
     Run {
         model,

@@ -34,7 +34,7 @@ fn run(
         ..SimOptions::default()
     };
     let sim = simulate(model, cell, &options).expect("simulation runs");
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     (sim, report)
 }
 
@@ -212,7 +212,8 @@ fn twenty_walls_of_the_three_storey_model_agree() {
         .place(&mut facts, &cell)
         .unwrap();
     let reasoned = framewright::frame::Ask::new(&engine).over(&facts).unwrap();
-    let plan = framewright::frame::plan::Plan::from_reasoned(&model, &reasoned);
+    let plan = framewright::frame::plan::Plan::from_reasoned(&model, &reasoned)
+        .expect("the rule base's tuples match their declarations");
     let walls: Vec<String> = plan.walls.iter().step_by(7).map(|w| w.id.clone()).collect();
     assert!(walls.len() >= 20, "{} walls sampled", walls.len());
     compare(&path, "study-abb", &walls);

@@ -36,7 +36,7 @@ fn run_cell(model_name: &str, cell: Cell, walls: &[&str]) -> (Simulation, SimRep
         ..SimOptions::default()
     };
     let sim = simulate(&model(model_name), &cell, &options).expect("simulation runs");
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     (sim, report)
 }
 

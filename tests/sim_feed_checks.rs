@@ -43,7 +43,7 @@ fn run(model: &PathBuf, cell: &Cell, walls: &[&str]) -> (Simulation, SimReport) 
     };
     let model = Model::open(model).expect("model opens");
     let sim = simulate(&model, cell, &options).expect("simulation runs");
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     (sim, report)
 }
 

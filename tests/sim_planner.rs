@@ -28,7 +28,7 @@ fn cell_with_table(centre: [f64; 3], size: [f64; 3]) -> Cell {
 fn run(cell: &Cell) -> (Simulation, SimReport) {
     let options = SimOptions::default();
     let sim = simulate(&tm2(), cell, &options).expect("simulation runs");
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     (sim, report)
 }
 

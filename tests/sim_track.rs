@@ -22,7 +22,7 @@ fn run(cell: &str) -> (Cell, Simulation, SimReport) {
         ..SimOptions::default()
     };
     let sim = simulate(&tm3(), &cell, &options).expect("simulation runs");
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt).expect("report");
     (cell, sim, report)
 }
 

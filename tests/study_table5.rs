@@ -63,7 +63,7 @@ fn run(model: &str, cell: &str) -> Arc<Run> {
         let cell = Cell::load(cell).expect("shipped cell");
         let options = SimOptions::default();
         let sim = simulate(&model, &cell, &options).expect("simulation runs");
-        let report = SimReport::new(&sim, options.dt);
+        let report = SimReport::new(&sim, options.dt).expect("report");
         Arc::new(Run {
             plan: sim.plan,
             report,

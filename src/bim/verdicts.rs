@@ -1,7 +1,7 @@
 //! The per-piece verdicts of a simulation, in the shape the BIM writers need them:
 //! framing and nailing status, the first reason (one line), the tightest reach margin.
 
-use crate::logic::Value;
+use crate::frame::rows::{ElementFraming, ElementNailing, ElementReason, RowError, SimIkSolved};
 use crate::sim::Simulation;
 use std::collections::BTreeMap;
 
@@ -16,36 +16,34 @@ pub struct ElementVerdict {
     pub reach_margin: Option<f64>,
 }
 
-fn sym(v: &Value) -> String {
-    v.as_symbol().unwrap_or_default().to_string()
-}
-
-/// Verdicts by piece id, for every piece the simulation ran.
-pub fn element_verdicts(sim: &Simulation) -> BTreeMap<String, ElementVerdict> {
+/// Verdicts by piece id, for every piece the simulation ran; an error when a verdict tuple
+/// does not match its relation's declaration.
+pub fn element_verdicts(sim: &Simulation) -> Result<BTreeMap<String, ElementVerdict>, RowError> {
     let r = &sim.reasoned;
-    let status = |relation: &str| -> BTreeMap<String, String> {
-        r.get(relation)
-            .iter()
-            .map(|t| (sym(&t[0]), sym(&t[1])))
-            .collect()
-    };
-    let framing = status("element_framing");
-    let nailing = status("element_nailing");
+    let framing: BTreeMap<String, String> = r
+        .rows::<ElementFraming>()?
+        .into_iter()
+        .map(|t| (t.p.to_string(), t.status.to_string()))
+        .collect();
+    let nailing: BTreeMap<String, String> = r
+        .rows::<ElementNailing>()?
+        .into_iter()
+        .map(|t| (t.p.to_string(), t.status.to_string()))
+        .collect();
     // Reasons sorted by stage (framing before nailing), then text: the first is the one shown.
     let mut reasons: BTreeMap<String, Vec<(bool, String)>> = BTreeMap::new();
-    for t in r.get("element_reason") {
-        let line = format!("{}: {}", sym(&t[2]), sym(&t[3]));
+    for t in r.rows::<ElementReason>()? {
+        let line = format!("{}: {}", t.component, t.message);
         reasons
-            .entry(sym(&t[0]))
+            .entry(t.p.to_string())
             .or_default()
-            .push((sym(&t[1]) != "framing", line));
+            .push((t.stage != "framing", line));
     }
     let mut margins: BTreeMap<String, f64> = BTreeMap::new();
-    for t in r.get("sim_ik_solved") {
-        if let Some(m) = t[2].as_float() {
-            let e = margins.entry(sym(&t[0])).or_insert(m);
-            *e = e.min(m);
-        }
+    for t in r.rows::<SimIkSolved>()? {
+        let m = t.reach_margin;
+        let e = margins.entry(t.p.to_string()).or_insert(m);
+        *e = e.min(m);
     }
     let mut out = BTreeMap::new();
     for p in framing.keys().chain(nailing.keys()) {
@@ -69,5 +67,5 @@ pub fn element_verdicts(sim: &Simulation) -> BTreeMap<String, ElementVerdict> {
             },
         );
     }
-    out
+    Ok(out)
 }

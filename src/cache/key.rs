@@ -150,7 +150,7 @@ mod tests {
         facts.extend(cell_facts(cell));
         let (reasoned, _) = Ask::new(&options.engine).placing(facts, cell).unwrap();
         let scene = Scene::build("tm3.ifc", &model, cell, &reasoned).unwrap();
-        let plan = plan::Plan::from_reasoned(&model, &reasoned);
+        let plan = plan::Plan::from_reasoned(&model, &reasoned).unwrap();
         plan.walls
             .iter()
             .map(|pw| {

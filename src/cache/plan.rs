@@ -14,7 +14,7 @@ use crate::cell::{Cell, OffsetX};
 use crate::frame::partition::{Indices, Partition};
 use crate::frame::placement::{FIRST_PASS, SearchMemo, SearchOptions, placement_relations};
 use crate::frame::plan::Plan;
-use crate::frame::rows::{PieceContainer, rows_of};
+use crate::frame::rows::{PieceBox, PieceContainer, PieceSize, Row, StoreyReach, Wall, rows_of};
 use crate::frame::{Ask, Facts, FrameError, Reasoned, RuleEngine, RuleLimits};
 use crate::logic::compiled::{Relations, builtin};
 use crate::logic::functors::defs::{box_centre, box_radius, dot};
@@ -99,7 +99,7 @@ pub(crate) fn reason_plan_cached_with<T: Send>(
     counts.cached = results
         .iter()
         .flatten()
-        .map(|r| r.get("wall").map_or(0, Vec::len))
+        .map(|r| r.get(Wall::RELATION).map_or(0, Vec::len))
         .sum();
 
     if results.iter().all(Option::is_none) {
@@ -154,7 +154,7 @@ pub(crate) fn reason_plan_cached_with<T: Send>(
     writer.commit();
     for (i, relations) in computed.into_inner().map_err(|_| poisoned())? {
         if results[i].is_none() {
-            let walls = relations.get("wall").map_or(0, Vec::len);
+            let walls = relations.get(Wall::RELATION).map_or(0, Vec::len);
             counts.computed += walls;
             if rejected[i] {
                 counts.rejected += walls;
@@ -164,7 +164,7 @@ pub(crate) fn reason_plan_cached_with<T: Send>(
     }
 
     let relations = merge(&partition, results);
-    limits.check_walls(relations.get("wall").map_or(0, Vec::len) as u64)?;
+    limits.check_walls(relations.get(Wall::RELATION).map_or(0, Vec::len) as u64)?;
     let after = then(&relations);
     Ok((
         Reasoned {
@@ -221,7 +221,7 @@ fn first_run<T: Send>(
     writer.commit();
     reasoned.relations.remove(REACH);
     let counts = CacheCounts {
-        computed: reasoned.get("wall").len(),
+        computed: reasoned.get(Wall::RELATION).len(),
         rejected,
         ..CacheCounts::default()
     };
@@ -233,7 +233,7 @@ fn first_run<T: Send>(
 fn store_parts(out: &Relations, stored: &Stored, writer: &PlanWriter) -> usize {
     let everything: Vec<usize> = (0..stored.partition.parts.len()).collect();
     let shares = shares(stored.partition, &everything, out);
-    let wall_slot = out.keys().position(|n| n == "wall");
+    let wall_slot = out.keys().position(|n| n == Wall::RELATION);
     shares
         .par_iter()
         .enumerate()
@@ -559,25 +559,16 @@ struct Extents {
 
 impl Extents {
     fn of(facts: &Facts, partition: &Partition) -> Extents {
-        let boxes: FxHashMap<&str, &OBox> = facts
-            .tuples
-            .get("piece_box")
-            .into_iter()
-            .flatten()
-            .filter_map(|(t, _)| match (t.first()?.as_symbol()?, t.get(1)?) {
-                (p, Value::Box(b)) => Some((p, &**b)),
-                _ => None,
-            })
+        // Facts the model's extraction wrote, read as the rules read them (others skipped).
+        let facts_of = |relation: &str| facts.tuples.get(relation).into_iter().flatten();
+        let boxes: FxHashMap<&str, OBox> = facts_of(PieceBox::RELATION)
+            .filter_map(|(t, _)| PieceBox::read(t))
+            .map(|t| (t.p, t.b))
             .collect();
-        let lumber: FxHashSet<&str> = facts
-            .tuples
-            .get("piece_size")
-            .into_iter()
-            .flatten()
-            .filter_map(|(t, _)| {
-                let (w, th) = (t.get(2)?.as_float()?, t.get(3)?.as_float()?);
-                (is_lumber_section(w, th)).then_some(t.first()?.as_symbol()?)
-            })
+        let lumber: FxHashSet<&str> = facts_of(PieceSize::RELATION)
+            .filter_map(|(t, _)| PieceSize::read(t))
+            .filter(|t| is_lumber_section(t.width, t.thickness))
+            .map(|t| t.p)
             .collect();
         Extents {
             lumber: partition
@@ -588,7 +579,7 @@ impl Extents {
                         .iter()
                         .map(|&i| partition.pieces[i].as_str())
                         .filter(|p| lumber.contains(p))
-                        .filter_map(|p| boxes.get(p).map(|b| **b))
+                        .filter_map(|p| boxes.get(p).copied())
                         .collect()
                 })
                 .collect(),
@@ -625,16 +616,13 @@ impl Extents {
 
     /// Whether every reach row an entry was computed with still holds for its container.
     fn agree(&self, container: usize, entry: &Relations) -> bool {
+        // A row off the declaration rejects the entry (it is recomputed), as a torn one.
         entry.get(REACH).into_iter().flatten().all(|row| {
-            let (Some(c), Some(Value::Vec3(k)), Some(Value::Float(lo)), Some(Value::Float(hi))) = (
-                row.first().and_then(Value::as_symbol),
-                row.get(1),
-                row.get(2),
-                row.get(3),
-            ) else {
+            let Some(r) = StoreyReach::read(row) else {
                 return false;
             };
-            self.index.get(c) == Some(&container) && self.along(container, *k) == Some((*lo, *hi))
+            self.index.get(r.c) == Some(&container)
+                && self.along(container, Vec3(r.k)) == Some((F64(r.lo), F64(r.hi)))
         })
     }
 }

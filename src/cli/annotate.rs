@@ -55,7 +55,7 @@ pub fn run(args: AnnotateArgs) -> CmdResult {
         let (sim, _) = Run::new(&model, &cell, &options)
             .limits(super::rule_limits()?)
             .simulate()?;
-        let verdicts = element_verdicts(&sim);
+        let verdicts = element_verdicts(&sim)?;
         // The model's own walls, each with its panels (the simulation's plan has one wall per
         // panel, of pieces partly not in the model).
         let Simulation {
@@ -67,7 +67,7 @@ pub fn run(args: AnnotateArgs) -> CmdResult {
         let reasoned = Ask::new(&engine)
             .within(super::rule_limits()?)
             .placed(facts, &cell)?;
-        let plan = Plan::from_reasoned(&model, &reasoned);
+        let plan = Plan::from_reasoned(&model, &reasoned)?;
         (model, plan, None)
     };
     let options = AnnotateOptions {

@@ -89,8 +89,8 @@ pub fn run(args: CompareArgs) -> CmdResult {
             &progress,
         )?;
         bars.finish();
-        let report = SimReport::new(&sim, options.dt);
-        bids.push(Bid::new(&sim, &report, cell));
+        let report = SimReport::new(&sim, options.dt)?;
+        bids.push(Bid::new(&sim, &report, cell)?);
         reports.push(report);
         // Each cell's simulation goes once its figures are taken: the peak memory stays one
         // cell's, not the sum of all.

@@ -44,7 +44,7 @@ pub fn plan_and_report(
     // The plan a simulation of it would have: one wall per panel the cell builds.
     Ok(match run.limits(super::rule_limits()?).from_cache()? {
         FromCache::Whole(sim) => {
-            let report = SimReport::new(&sim, options.dt);
+            let report = SimReport::new(&sim, options.dt)?;
             (sim.plan, Some(report))
         }
         FromCache::Missing(prepared) => (prepared.plan, None),

@@ -53,7 +53,7 @@ pub fn run(args: ProgramArgs) -> CmdResult {
         .named(&name)
         .limits(super::rule_limits()?)
         .simulate()?;
-    let report = SimReport::new(&sim, options.dt);
+    let report = SimReport::new(&sim, options.dt)?;
     // Every file is made before any is written: a bad `[io]` writes nothing.
     let walls = programs(&sim, &report, &cell, &name, args.format)?;
     let mut summary = String::new();

@@ -133,7 +133,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     )?;
     bars.finish();
     warn_if_unwritable(cache.as_ref());
-    let mut report = SimReport::new(&sim, options.dt);
+    let mut report = SimReport::new(&sim, options.dt)?;
     report.sim.cache = counts;
     if let Some(rules) = &user_rules {
         report.add_findings(&rules.evaluate(&sim.reasoned.relations)?);
@@ -154,7 +154,7 @@ pub fn run(args: SimulateArgs) -> CmdResult {
     let written = if args.json {
         write_stdout(|out| report.write_json(out))
     } else {
-        let totals = Bid::new(&sim, &report, &cell).totals_text();
+        let totals = Bid::new(&sim, &report, &cell)?.totals_text();
         print_stdout(&format!("{}{totals}", report.to_terminal(args.verbose)))
     };
     leave_to_exit((model, sim, report));

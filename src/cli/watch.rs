@@ -294,7 +294,7 @@ impl Watch {
             .simulate()
             .map_err(|e| e.to_string())?;
         warn_if_unwritable(self.cache.as_ref());
-        let mut report = SimReport::new(&sim, options.dt);
+        let mut report = SimReport::new(&sim, options.dt).map_err(|e| e.to_string())?;
         if let Some(rules) = &self.rules {
             report.add_findings(
                 &rules

@@ -345,7 +345,7 @@ fn plan_of(
         .within(super::rule_limits()?)
         .only(Plan::RELATIONS)
         .placed(facts, cell)?;
-    let plan = Plan::from_reasoned(model, &reasoned);
+    let plan = Plan::from_reasoned(model, &reasoned)?;
     Ok((plan, reasoned.relations))
 }
 

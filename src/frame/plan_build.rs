@@ -2,104 +2,94 @@
 //! targets, split into the panels the cell's limits allow (`panels`), and named after the
 //! panels of the whole model when it is a panelized model's (`panelize`).
 
-use super::Reasoned;
 use super::panel::WallPanels;
 use super::panels;
 use super::plan::{NailingTarget, Plan, Wall};
+use super::rows::{
+    self, AssemblyRank, FrameWarning, FramingTarget, PieceMaterial, Precedence, Role, Row,
+    RowError, WallFrame, WallGroup, WallOf, WallSize, rows_of,
+};
+use super::{FrameError, Reasoned};
 use crate::geom::Point3;
 use crate::ifc::Model;
-use crate::logic::Value;
 use crate::logic::compiled::Relations;
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::Isometry3;
 use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
 
-fn sym(v: &Value) -> &str {
-    v.as_symbol().unwrap_or_default()
-}
-
-fn owned(v: &Value) -> String {
-    sym(v).to_string()
-}
-
-fn float(v: &Value) -> f64 {
-    v.as_float().unwrap_or(f64::NAN)
-}
-
-fn vec3(v: &Value) -> Vector3<f64> {
-    match v {
-        Value::Vec3(x) => x.0,
-        _ => Vector3::from_element(f64::NAN),
+/// `rows` bucketed by the wall of the piece `piece` names (rows of pieces in no wall dropped).
+fn by_wall_of<'r, R>(
+    rows: &'r [R],
+    piece: impl Fn(&R) -> &'static str,
+    wall_of_piece: &FxHashMap<&str, &'static str>,
+) -> FxHashMap<&'static str, Vec<&'r R>> {
+    let mut by: FxHashMap<&str, Vec<&R>> = FxHashMap::default();
+    for t in rows {
+        if let Some(w) = wall_of_piece.get(piece(t)) {
+            by.entry(*w).or_default().push(t);
+        }
     }
-}
-
-fn iso(v: &Value) -> Isometry3<f64> {
-    match v {
-        Value::Iso(x) => x.0,
-        _ => Isometry3::identity(),
-    }
+    by
 }
 
 impl Plan {
     /// The relations `from_reasoned` reads (`Ask::only` returns only these).
     pub const RELATIONS: &'static [&'static str] = super::rule_reads::PLAN;
 
-    /// Collects the plan from the rule base's relations (missing relations give empty parts).
-    pub fn from_reasoned(model: &Model, r: &Reasoned) -> Plan {
+    /// Collects the plan from the rule base's relations (missing relations give empty parts);
+    /// an error when a tuple does not match its relation's declaration.
+    pub fn from_reasoned(model: &Model, r: &Reasoned) -> Result<Plan, FrameError> {
         // The relations alone (the interpreter `r` may hold is not shared between threads).
         Plan::from_relations(model, &r.relations)
     }
 
     /// `from_reasoned` on the relations alone (others than `RELATIONS` are not read).
-    pub fn from_relations(model: &Model, relations: &Relations) -> Plan {
+    pub fn from_relations(model: &Model, relations: &Relations) -> Result<Plan, FrameError> {
         use rayon::prelude::*;
-        let get = |relation: &str| relations.get(relation).map_or(&[][..], Vec::as_slice);
         // Lookups borrow the relations' symbols; only what the plan keeps is copied.
         let index = model.piece_positions();
         let file_order = |p: &str| index.get(p).copied().unwrap_or(usize::MAX);
-        let pairs = |relation: &str| -> Vec<(&str, &str)> {
-            get(relation)
-                .iter()
-                .map(|t| (sym(&t[0]), sym(&t[1])))
-                .collect()
-        };
-        let wall_pairs = pairs("wall_of");
-        let wall_of_piece: FxHashMap<&str, &str> = wall_pairs.iter().copied().collect();
+        let wall_pairs = rows_of::<WallOf>(relations)?;
+        let wall_of_piece: FxHashMap<&str, &'static str> =
+            wall_pairs.iter().map(|t| (t.p, t.w)).collect();
         // The per-piece maps and the walls are built side by side.
-        let piece_maps = || {
-            let roles: BTreeMap<String, String> = pairs("role")
+        let piece_maps = || -> Result<_, RowError> {
+            let roles: BTreeMap<String, String> = rows_of::<Role>(relations)?
                 .into_iter()
-                .map(|(p, role)| (p.to_string(), role.to_string()))
+                .map(|t| (t.p.to_string(), t.r.to_string()))
                 .collect();
-            let masses: BTreeMap<String, f64> = get("piece_material")
-                .iter()
+            let masses: BTreeMap<String, f64> = rows_of::<PieceMaterial>(relations)?
+                .into_iter()
                 .filter_map(|t| {
-                    let p = model.pieces().get(*index.get(sym(&t[0]))?)?;
-                    Some((p.id.clone(), p.obox.volume() * float(&t[2])))
+                    let p = model.pieces().get(*index.get(t.p)?)?;
+                    Some((p.id.clone(), p.obox.volume() * t.density))
                 })
                 .collect();
-            (roles, masses)
+            Ok((roles, masses))
         };
-        let build_walls = || {
-            let groups: FxHashMap<&str, (&str, &str)> = get("wall_group")
-                .iter()
-                .map(|t| (sym(&t[0]), (sym(&t[1]), sym(&t[3]))))
+        let build_walls = || -> Result<Vec<Wall>, RowError> {
+            let groups: FxHashMap<&str, (&str, &str)> = rows_of::<WallGroup>(relations)?
+                .into_iter()
+                .map(|t| (t.w, (t.g, t.g_name)))
                 .collect();
-            let frames: FxHashMap<&str, Isometry3<f64>> = get("wall_frame")
-                .iter()
-                .map(|t| (sym(&t[0]), iso(&t[1])))
+            let frames: FxHashMap<&str, Isometry3<f64>> = rows_of::<WallFrame>(relations)?
+                .into_iter()
+                .map(|t| (t.w, t.f))
                 .collect();
-            let sizes: FxHashMap<&str, [f64; 3]> = get("wall_size")
-                .iter()
-                .map(|t| (sym(&t[0]), [float(&t[1]), float(&t[2]), float(&t[3])]))
+            let sizes: FxHashMap<&str, [f64; 3]> = rows_of::<WallSize>(relations)?
+                .into_iter()
+                .map(|t| (t.w, [t.length, t.height, t.thickness]))
                 .collect();
-            let ranks: FxHashMap<&str, i64> = get("assembly_rank")
-                .iter()
-                .map(|t| (sym(&t[0]), t[1].as_number().unwrap_or(i64::MAX)))
+            let ranks: FxHashMap<&str, i64> = rows_of::<AssemblyRank>(relations)?
+                .into_iter()
+                .map(|t| (t.p, t.k))
                 .collect();
 
             // Walls in file order of their key piece.
-            let mut keys: Vec<&str> = get("wall").iter().map(|t| sym(&t[0])).collect();
+            let mut keys: Vec<&str> = rows_of::<rows::Wall>(relations)?
+                .into_iter()
+                .map(|t| t.w)
+                .collect();
             keys.sort_by_key(|k| file_order(k));
             // Members, precedence, nailing and framing targets bucketed by wall in one pass each.
             // Each member with its place in the file, looked up once (not in every comparison).
@@ -107,26 +97,20 @@ impl Plan {
             for (p, w) in &wall_of_piece {
                 members.entry(w).or_default().push((file_order(p), p));
             }
-            let mut precedence_by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
-            for t in get("precedence") {
+            let precedences = rows_of::<Precedence>(relations)?;
+            let mut precedence_by: FxHashMap<&str, Vec<&Precedence>> = FxHashMap::default();
+            for t in &precedences {
                 if let (Some(w), Some(w2)) =
-                    (wall_of_piece.get(sym(&t[0])), wall_of_piece.get(sym(&t[1])))
+                    (wall_of_piece.get(t.before), wall_of_piece.get(t.after))
                     && w == w2
                 {
                     precedence_by.entry(w).or_default().push(t);
                 }
             }
-            let by_wall_of_first = |relation: &str| {
-                let mut by: FxHashMap<&str, Vec<&[Value]>> = FxHashMap::default();
-                for t in get(relation) {
-                    if let Some(w) = wall_of_piece.get(sym(&t[0])) {
-                        by.entry(w).or_default().push(t);
-                    }
-                }
-                by
-            };
-            let nails_by = by_wall_of_first("nailing_target");
-            let framing_by = by_wall_of_first("framing_target");
+            let nails = rows_of::<rows::NailingTarget>(relations)?;
+            let nails_by = by_wall_of(&nails, |t| t.plate, &wall_of_piece);
+            let framings = rows_of::<FramingTarget>(relations)?;
+            let framing_by = by_wall_of(&framings, |t| t.p, &wall_of_piece);
             let walls: Vec<Wall> = keys
                 .par_iter()
                 .enumerate()
@@ -146,7 +130,13 @@ impl Plan {
                         .get(key)
                         .into_iter()
                         .flatten()
-                        .map(|t| (owned(&t[0]), owned(&t[1]), owned(&t[2])))
+                        .map(|t| {
+                            (
+                                t.before.to_string(),
+                                t.after.to_string(),
+                                t.reason.to_string(),
+                            )
+                        })
                         .collect();
                     precedence.sort();
                     let mut nailing_targets: Vec<NailingTarget> = nails_by
@@ -154,14 +144,14 @@ impl Plan {
                         .into_iter()
                         .flatten()
                         .map(|t| NailingTarget {
-                            plate: owned(&t[0]),
-                            member: owned(&t[1]),
-                            kind: owned(&t[2]),
-                            u: float(&t[3]),
-                            v: float(&t[4]),
-                            w: float(&t[5]),
-                            world: Point3::from(vec3(&t[6])),
-                            direction: vec3(&t[7]),
+                            plate: t.plate.to_string(),
+                            member: t.member.to_string(),
+                            kind: t.kind.to_string(),
+                            u: t.u,
+                            v: t.v,
+                            w: t.w,
+                            world: Point3::from(t.world),
+                            direction: t.direction,
                         })
                         .collect();
                     nailing_targets.sort_by(|a, b| {
@@ -175,7 +165,7 @@ impl Plan {
                         .get(key)
                         .into_iter()
                         .flatten()
-                        .map(|t| (sym(&t[0]), iso(&t[1])))
+                        .map(|t| (t.p, t.pose))
                         .collect();
                     framing.sort_by_key(|(p, _)| position.get(p).copied());
                     let group = groups.get(key);
@@ -206,9 +196,10 @@ impl Plan {
                     }
                 })
                 .collect();
-            walls
+            Ok(walls)
         };
-        let ((roles, masses), mut walls) = rayon::join(piece_maps, build_walls);
+        let (maps, walls) = rayon::join(piece_maps, build_walls);
+        let ((roles, masses), mut walls) = (maps?, walls?);
         let panel_limits = panels::limits_from(relations);
         if let Some(limits) = &panel_limits {
             panels::split_walls(&mut walls, relations, &roles, &masses, limits);
@@ -220,28 +211,32 @@ impl Plan {
         // From the relation's rows, which come sorted by piece: the map is built without sorting.
         let wall_of = wall_pairs
             .iter()
-            .map(|(p, w)| (p.to_string(), wall_ids.get(w).unwrap_or(w).to_string()))
-            .collect();
-        let mut warnings: Vec<String> = get("frame_warning")
-            .iter()
             .map(|t| {
-                let subject = sym(&t[0]);
-                let subject = wall_ids.get(subject).copied().unwrap_or(subject);
-                format!("{subject}: {}", sym(&t[1]))
+                (
+                    t.p.to_string(),
+                    wall_ids.get(t.w).unwrap_or(&t.w).to_string(),
+                )
+            })
+            .collect();
+        let mut warnings: Vec<String> = rows_of::<FrameWarning>(relations)?
+            .into_iter()
+            .map(|t| {
+                let subject = wall_ids.get(t.subject).copied().unwrap_or(t.subject);
+                format!("{subject}: {}", t.message)
             })
             .collect();
         warnings.extend(panel_warnings(&walls));
         if walls.is_empty() {
             warnings.push(no_walls_reason(model, relations));
         }
-        Plan {
+        Ok(Plan {
             walls,
             wall_of,
             roles,
             masses,
             warnings,
             panel_limits,
-        }
+        })
     }
 }
 
@@ -323,9 +318,9 @@ fn no_walls_reason(model: &Model, relations: &Relations) -> String {
     if pieces == 0 {
         return "no wall frames: the model holds no members, columns, beams, plates or proxies with solid geometry".into();
     }
-    let lumber = count("lumber");
-    let upright = count("across");
-    let coplanar = count("coplanar") / 2;
+    let lumber = count(rows::Lumber::RELATION);
+    let upright = count(rows::Across::RELATION);
+    let coplanar = count(rows::Coplanar::RELATION) / 2;
     format!(
         "no wall frames: of {pieces} pieces, {lumber} have lumber sections, {upright} stand plumb or lie level in a wall plane, and {coplanar} pairs touch in one plane; a wall needs at least three lumber pieces (plates and studs) touching in one vertical plane"
     )

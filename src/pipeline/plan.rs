@@ -36,7 +36,7 @@ pub fn plan(
                 })?;
             Ok(Planned {
                 reasoned,
-                plan,
+                plan: plan?,
                 cache: Some(counts),
             })
         }
@@ -45,7 +45,7 @@ pub fn plan(
                 .within(limits)
                 .only(Plan::RELATIONS)
                 .placed(facts, cell)?;
-            let plan = Plan::from_reasoned(model, &reasoned);
+            let plan = Plan::from_reasoned(model, &reasoned)?;
             Ok(Planned {
                 reasoned,
                 plan,

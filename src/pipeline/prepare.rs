@@ -69,7 +69,7 @@ pub fn prepare_facts(
 ) -> Result<Prepared, SimError> {
     let ask = Ask::new(engine).within(*limits);
     let (reasoned, facts) = ask.placing(facts, cell)?;
-    let plan = Plan::from_reasoned(model, &reasoned);
+    let plan = Plan::from_reasoned(model, &reasoned)?;
     let Some(cut) = panelize(model, &plan) else {
         let scene = Scene::build(model_name, model, cell, &reasoned)?;
         return Ok(Prepared {
@@ -87,7 +87,7 @@ pub fn prepare_facts(
     facts.extend(cut.facts);
     let facts = restrict(facts);
     let (reasoned, facts) = ask.placing(facts, &whole_panels)?;
-    let mut panels = Plan::from_reasoned(&cut.model, &reasoned);
+    let mut panels = Plan::from_reasoned(&cut.model, &reasoned)?;
     panels.name_after_panels(&plan);
     // What the split said about the whole walls (limits dropped, panels over a limit).
     let mut warnings = plan.panel_warnings();

@@ -14,7 +14,7 @@
 use super::failure_class::{FailureClass, nail_class, piece_class};
 use super::simulate::SimReport;
 use crate::cell::Cell;
-use crate::logic::Value;
+use crate::frame::rows::{NailOk, Row, RowError, WallFramingCount, WallNailCount};
 use crate::sim::Simulation;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -83,14 +83,22 @@ fn round(x: f64, per: f64) -> f64 {
     if r == 0.0 { 0.0 } else { r }
 }
 
-/// `(total, done)` of a per-wall count relation, by wall key.
-fn counts(sim: &Simulation, relation: &str) -> BTreeMap<String, (usize, usize)> {
-    let n = |v: &Value| v.as_number().map_or(0, |n| n.max(0) as usize);
-    sim.reasoned
-        .get(relation)
+/// `(total, done)` of a per-wall count relation, by wall key; `fields` picks the wall and the
+/// counts of a row.
+fn counts<R: Row>(
+    sim: &Simulation,
+    fields: impl Fn(&R) -> (&'static str, i64, i64),
+) -> Result<BTreeMap<String, (usize, usize)>, RowError> {
+    let n = |n: i64| n.max(0) as usize;
+    Ok(sim
+        .reasoned
+        .rows::<R>()?
         .iter()
-        .filter_map(|t| Some((t[0].as_symbol()?.to_string(), (n(&t[1]), n(&t[2])))))
-        .collect()
+        .map(|t| {
+            let (wall, total, done) = fields(t);
+            (wall.to_string(), (n(total), n(done)))
+        })
+        .collect())
 }
 
 /// The rules' counts with the failures by class; the classes add up to `failed` (a failure
@@ -119,20 +127,16 @@ fn tally(planned: usize, done: usize, failures: Vec<(FailureClass, String)>) -> 
 }
 
 impl Bid {
-    pub fn new(sim: &Simulation, report: &SimReport, cell: &Cell) -> Bid {
-        let framing = counts(sim, "wall_framing_count");
-        let nailing = counts(sim, "wall_nail_count");
+    /// The figures of `sim`; an error when a count tuple does not match its relation's
+    /// declaration.
+    pub fn new(sim: &Simulation, report: &SimReport, cell: &Cell) -> Result<Bid, RowError> {
+        let framing = counts(sim, |t: &WallFramingCount| (t.w, t.total, t.framed))?;
+        let nailing = counts(sim, |t: &WallNailCount| (t.w, t.total, t.ok))?;
         let nail_ok: BTreeSet<(String, String, i64)> = sim
             .reasoned
-            .get("nail_ok")
-            .iter()
-            .filter_map(|t| {
-                Some((
-                    t[0].as_symbol()?.to_string(),
-                    t[1].as_symbol()?.to_string(),
-                    t[2].as_number()?,
-                ))
-            })
+            .rows::<NailOk>()?
+            .into_iter()
+            .map(|t| (t.plate.to_string(), t.member.to_string(), t.k))
             .collect();
         let robot = &cell.robot;
         let mut piece_failures = Vec::new();
@@ -190,7 +194,7 @@ impl Bid {
         let complete_metres = sum(&|p| p.length_m, true);
         let complete_time = sum(&|p| p.framing_s + p.nailing_s, true);
         let walls: BTreeSet<&str> = per_panel.iter().map(|p| p.wall_id.as_str()).collect();
-        Bid {
+        Ok(Bid {
             cell: cell.name.clone(),
             robot: robot.name.clone(),
             track_travel_m: cell
@@ -219,7 +223,7 @@ impl Bid {
             metres_per_hour: (complete_time > 0.0)
                 .then(|| round(complete_metres / complete_time * 3600.0, 1e6)),
             per_panel,
-        }
+        })
     }
 
     /// The robot, with its track when it has one.

@@ -72,6 +72,8 @@ pub fn report_files_within(
         .filter_map(|r| input.sim.plan.walls.iter().find(|w| w.key == r.wall))
         .filter_map(|w| WallView::new(input.sim, input.report, Some(model), &w.id))
         .collect();
+    let bid =
+        super::bid::Bid::new(input.sim, input.report, input.cell).map_err(std::io::Error::other)?;
     let split = walls.len() > WALLS_PER_PAGE;
     let mut files = Vec::new();
     let scene_name = |i: usize| {
@@ -88,7 +90,7 @@ pub fn report_files_within(
         html! {
             (header(input))
             h2 { "Summary" }
-            (super::bid_html::summary_table(&[super::bid::Bid::new(input.sim, input.report, input.cell)]))
+            (super::bid_html::summary_table(&[bid]))
             (results_table(&walls, split.then_some(&page_name), &scene_name))
             @if split {
                 @for w in &walls { (causes(w)) }

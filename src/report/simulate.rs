@@ -4,8 +4,10 @@
 //! comes from the verdict relations (`rules/verdicts.dl`) and the executor's records; no
 //! wall-clock figures, so the JSON is byte-identical run to run.
 
-use crate::frame::Reasoned;
-use crate::logic::Value;
+use crate::frame::rows::{
+    ElementFraming, ElementNailing, ElementReason, RowError, WallFailedComponent, WallFeeding,
+    WallStage,
+};
 use crate::sim::Simulation;
 use crate::sim::record::NailOutcome;
 use serde::Serialize;
@@ -224,50 +226,52 @@ fn combined(stages: &[&Stage]) -> Stage {
     }
 }
 
-fn sym(v: &Value) -> String {
-    v.as_symbol().unwrap_or_default().to_string()
-}
-
-fn float(v: &Value) -> f64 {
-    v.as_float().unwrap_or(f64::NAN)
-}
-
-/// Tuples of a relation as symbol/float rows.
-fn rows<'a>(r: &'a Reasoned, relation: &str) -> impl Iterator<Item = &'a [Value]> {
-    r.get(relation).iter().map(Vec::as_slice)
-}
-
 impl SimReport {
-    pub fn new(sim: &Simulation, dt: f64) -> SimReport {
+    /// The report of `sim`; an error when a verdict tuple does not match its relation's
+    /// declaration.
+    pub fn new(sim: &Simulation, dt: f64) -> Result<SimReport, RowError> {
         let r = &sim.reasoned;
         let mut reasons: BTreeMap<(String, String), Vec<Reason>> = BTreeMap::new();
-        for t in rows(r, "element_reason") {
+        for t in r.rows::<ElementReason>()? {
             reasons
-                .entry((sym(&t[0]), sym(&t[1])))
+                .entry((t.p.to_string(), t.stage.to_string()))
                 .or_default()
                 .push(Reason {
-                    component: sym(&t[2]),
-                    message: sym(&t[3]),
+                    component: t.component.to_string(),
+                    message: t.message.to_string(),
                 });
         }
-        let status = |relation: &str| -> BTreeMap<String, String> {
-            rows(r, relation)
-                .map(|t| (sym(&t[0]), sym(&t[1])))
-                .collect()
-        };
-        let framing = status("element_framing");
-        let nailing = status("element_nailing");
-        let mut components: BTreeMap<(String, String), Vec<String>> = BTreeMap::new();
-        for t in rows(r, "wall_failed_component") {
-            components
-                .entry((sym(&t[0]), sym(&t[1])))
-                .or_default()
-                .push(sym(&t[2]));
-        }
-        let stages: BTreeMap<(String, String), (String, f64)> = rows(r, "wall_stage")
-            .map(|t| ((sym(&t[0]), sym(&t[1])), (sym(&t[2]), float(&t[3]))))
+        let status = |of: &str, status: &str| (of.to_string(), status.to_string());
+        let framing: BTreeMap<String, String> = r
+            .rows::<ElementFraming>()?
+            .into_iter()
+            .map(|t| status(t.p, t.status))
             .collect();
-        let feeding = status("wall_feeding");
+        let nailing: BTreeMap<String, String> = r
+            .rows::<ElementNailing>()?
+            .into_iter()
+            .map(|t| status(t.p, t.status))
+            .collect();
+        let mut components: BTreeMap<(String, String), Vec<String>> = BTreeMap::new();
+        for t in r.rows::<WallFailedComponent>()? {
+            components
+                .entry((t.w.to_string(), t.stage.to_string()))
+                .or_default()
+                .push(t.component.to_string());
+        }
+        let stages: BTreeMap<(String, String), (String, f64)> = r
+            .rows::<WallStage>()?
+            .into_iter()
+            .map(|t| {
+                let key = (t.w.to_string(), t.stage.to_string());
+                (key, (t.status.to_string(), t.time))
+            })
+            .collect();
+        let feeding: BTreeMap<String, String> = r
+            .rows::<WallFeeding>()?
+            .into_iter()
+            .map(|t| status(t.w, t.status))
+            .collect();
 
         // Records and relations name a wall by its key piece; the report by the whole wall's
         // id and the panel's.
@@ -411,7 +415,7 @@ impl SimReport {
             all_inside_members: fired.iter().all(|t| t.member_inside == Some(true)),
             targets,
         };
-        SimReport {
+        Ok(SimReport {
             schema: "framewright.simulate/1",
             model: sim.scene.model.clone(),
             cell: sim.scene.cell.clone(),
@@ -426,7 +430,7 @@ impl SimReport {
                 dt: r6(dt),
                 cache: None,
             },
-        }
+        })
     }
 
     /// Adds the user rules' findings to the elements they are about.
