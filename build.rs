@@ -123,6 +123,9 @@ fn main() {
         let rows = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
             .join("framing_rows.rs");
         std::fs::write(&rows, typed_rows(&program)).expect("write the typed rows");
+        let tables = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
+            .join("framing_tables.rs");
+        std::fs::write(&tables, typed_tables(&program)).expect("write the typed tables");
     }
     if test_programs {
         test_and_bench_programs(&root, &mut out, &mut table);
@@ -180,10 +183,7 @@ fn test_and_bench_programs(root: &Path, out: &mut String, table: &mut Vec<(Strin
 /// `builtin_plan_placed`), and `BUILTIN_PLAN_RELATIONS`, the relations it derives exactly
 /// as the whole rule base does (a caller wanting any other must run the whole).
 fn plan_scope(program: &front::Program) -> String {
-    let mut targets: Vec<&str> = rule_reads::PLAN.to_vec();
-    targets.extend(rule_reads::PLACEMENT_FIRST_PASS);
-    targets.push(rule_reads::STOREY_REACH);
-    let scope = program.upstream_of(&targets);
+    let scope = program.upstream_of(&typed_targets());
     let cut = program.restricted_to(&scope);
     let mut code = front::codegen::generate(&cut, "builtin_plan")
         .unwrap_or_else(|e| panic!("the rules `plan` reads cannot be compiled: {e}"));
@@ -242,6 +242,66 @@ fn placed_slice(program: &front::Program, base: &str, name: &str) -> String {
         let _ = writeln!(code, "        base.{f} = std::mem::take(&mut p.{f});");
     }
     code.push_str("    }\n}\n");
+    code
+}
+
+/// What the typed runner (`frame::builtin`) reads back: what `plan`, the placement
+/// search's first pass and the plan cache's storey check read (`rule_reads`), each once, in
+/// that order. `plan_scope` cuts the rule base to these same relations.
+fn typed_targets() -> Vec<&'static str> {
+    let mut targets: Vec<&str> = Vec::new();
+    let reads = rule_reads::PLAN
+        .iter()
+        .chain(rule_reads::PLACEMENT_FIRST_PASS)
+        .chain([&rule_reads::STOREY_REACH]);
+    for r in reads {
+        if !targets.contains(r) {
+            targets.push(r);
+        }
+    }
+    targets
+}
+
+/// The typed runner's tables (`frame::builtin`'s `inputs!` and `outputs!` lists), from
+/// the `.decl`s: every `.input` relation in declaration order but the simulation's records
+/// (`sim_…`, rules/sim.dl: the runner serves `plan` and the placement search, which never
+/// have them; `handles` sends facts holding them to the whole engine), and the outputs
+/// (`typed_targets`). Fields are named and typed as the code generator names and types them.
+fn typed_tables(program: &front::Program) -> String {
+    let targets = typed_targets();
+    let mut code = String::from("inputs! {\n");
+    for rel in &program.relations {
+        if rel.input.is_none() || rel.name.starts_with("sim_") {
+            continue;
+        }
+        let cols: Vec<String> = rel
+            .attrs
+            .iter()
+            .enumerate()
+            .map(|(i, a)| format!("{i}: {}", front::codegen::rust_ty(a.ty)))
+            .collect();
+        let _ = writeln!(
+            code,
+            "    {:?} => {}({});",
+            rel.name,
+            front::codegen::rel_name(&rel.name),
+            cols.join(", ")
+        );
+    }
+    code.push_str("}\noutputs! {\n");
+    for name in &targets {
+        let rel = program
+            .relation(name)
+            .unwrap_or_else(|| panic!("`{name}` (rule_reads) is not declared in rules/"));
+        let cols: Vec<String> = (0..rel.attrs.len()).map(|i| i.to_string()).collect();
+        let _ = writeln!(
+            code,
+            "    {name:?} => {}({});",
+            front::codegen::rel_name(name),
+            cols.join(", ")
+        );
+    }
+    code.push_str("}\n");
     code
 }
 

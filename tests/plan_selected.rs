@@ -6,11 +6,11 @@
 //! twice (the path before), on TM1–TM3 and a generated multi-storey model with grouped
 //! walls, openings and property sets, with both shipped cells.
 use framewright::cell::Cell;
+use framewright::frame::builtin;
 use framewright::frame::placement::SearchOptions;
 use framewright::frame::plan::Plan;
 use framewright::frame::{Ask, Reasoned, RuleEngine, cell_facts, model_facts};
 use framewright::ifc::Model;
-use framewright::logic::compiled::builtin;
 use framewright::report::plan::PlanReport;
 use framewright::synth::building::{BlockSpec, blocks};
 use framewright::synth::{Grouping, WriteOptions, models, write_ifc};

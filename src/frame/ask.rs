@@ -2,6 +2,7 @@
 //! relations the caller reads and whether provenance is kept; its methods say what it runs
 //! over (the facts as they are, or with the cell's placement search placing the walls first).
 
+use super::builtin;
 use super::placement::{
     FIRST_PASS, SearchMemo, SearchOptions, placement_facts, placement_relations,
 };
@@ -10,7 +11,7 @@ use super::{
     reason_unchecked,
 };
 use crate::cell::{Cell, OffsetX};
-use crate::logic::compiled::{Relations, builtin};
+use crate::logic::compiled::Relations;
 
 /// A question to the rule base. `Ask::new(&engine)` asks for every relation within the
 /// default bounds; the builder methods narrow it.

@@ -3,6 +3,7 @@
 //! runs the same rules for `--rules-dir`, user rules and provenance.
 
 mod ask;
+pub mod builtin;
 pub mod cell_facts;
 pub mod containers;
 pub mod facts;
@@ -205,7 +206,7 @@ pub(crate) type PlaceFn<'a> = &'a (dyn Fn(&Relations) -> Relations + Sync);
 /// `into_by_container` by a caller done with its facts); with `place` (and `selected`,
 /// which the typed runner must handle),
 /// each part's placement facts come from `place` between a first pass and the rules they
-/// reach (`compiled::builtin::run_placed`).
+/// reach (`builtin::run_placed`).
 pub(crate) fn reason_compiled_placing(
     mut parts: Vec<Relations>,
     selected: Option<&[&str]>,
@@ -228,8 +229,8 @@ pub(crate) fn reason_compiled_placing(
         .into_par_iter()
         .map(|part| -> Result<Relations, FrameError> {
             let (relations, tuples) = match (&wanted, place) {
-                (Some(w), Some(place)) if compiled::builtin::handles(&part, w) => {
-                    let r = compiled::builtin::run_placed(&part, placement::FIRST_PASS, w, place)
+                (Some(w), Some(place)) if builtin::handles(&part, w) => {
+                    let r = builtin::run_placed(&part, placement::FIRST_PASS, w, place)
                         .map_err(FrameError::CompiledRun)?;
                     (r.relations, r.tuples)
                 }
@@ -239,9 +240,8 @@ pub(crate) fn reason_compiled_placing(
                             .into(),
                     ));
                 }
-                (Some(w), None) if compiled::builtin::handles(&part, w) => {
-                    let r = compiled::builtin::run_selected(&part, w)
-                        .map_err(FrameError::CompiledRun)?;
+                (Some(w), None) if builtin::handles(&part, w) => {
+                    let r = builtin::run_selected(&part, w).map_err(FrameError::CompiledRun)?;
                     (r.relations, r.tuples)
                 }
                 _ => {

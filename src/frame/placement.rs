@@ -160,7 +160,7 @@ impl Slot {
 /// Takes one placement fact: relation, tuple, and how to say where it came from.
 type AddFact<'a> = dyn FnMut(&'static str, Vec<Value>, &dyn Fn() -> String) + 'a;
 
-/// The placement facts of one part for the typed runner (`compiled::builtin::run_placed`):
+/// The placement facts of one part for the typed runner (`builtin::run_placed`):
 /// what `placement_facts` gives, without origins, each relation sorted.
 pub(crate) fn placement_relations(
     cell: &Cell,

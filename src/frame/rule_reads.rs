@@ -1,6 +1,6 @@
 //! The relations of the built-in rule base that fixed readers take. `build.rs` includes
 //! this file too: it compiles, beside the whole rule base, a copy cut down to the rules
-//! these relations depend on (`builtin_plan`), which `compiled::builtin` runs whenever a
+//! these relations depend on (`builtin_plan`), which `frame::builtin` runs whenever a
 //! caller wants nothing outside it; and it cuts the rules the placement search's facts reach.
 
 /// What `Plan::from_reasoned` reads.

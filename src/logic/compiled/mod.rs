@@ -5,7 +5,6 @@
 //! `tests/logic/*.dl`, `benches/logic/*.dl` and Soufflé corpus program the
 //! generator takes, listed by path.
 
-pub mod builtin;
 pub mod rt;
 
 pub use crate::logic::error::CompiledError;

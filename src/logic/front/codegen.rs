@@ -39,7 +39,8 @@ impl fmt::Display for CodegenError {
 
 impl std::error::Error for CodegenError {}
 
-fn rust_ty(t: BaseTy) -> &'static str {
+/// The Rust type of a column of type `t` in a generated program.
+pub fn rust_ty(t: BaseTy) -> &'static str {
     match t {
         BaseTy::Number => "i64",
         BaseTy::Unsigned => "u64",
@@ -55,7 +56,8 @@ fn ident(name: &str) -> String {
     name.replace('?', "_Q")
 }
 
-fn rel_name(name: &str) -> String {
+/// The field of a generated program's `Prog` that holds relation `name`.
+pub fn rel_name(name: &str) -> String {
     format!("r_{}", ident(name))
 }
 

@@ -3,9 +3,13 @@
 //! back into `Value` tuples (the wrapper converts and sorts all of them, most of which
 //! `plan` never reads), and the program's own tables are dropped right after. A caller that
 //! wants only relations `plan` reads gets them from `builtin_plan`, the rule base cut down to
-//! the rules those depend on (`build.rs`, `frame::rule_reads`).
+//! the rules those depend on (`build.rs`, `frame::rule_reads`). It lives beside the
+//! framing rule base it names, not in `logic::compiled`, which is the generic engine.
 
-use super::{BUILTIN_PLAN_RELATIONS, CompiledError, Relations, builtin_plan, builtin_rules, rt};
+use crate::logic::compiled::{
+    BUILTIN_PLAN_RELATIONS, CompiledError, Relations, builtin_placed, builtin_plan,
+    builtin_plan_placed, builtin_rules, rt,
+};
 use crate::logic::value::{Column, F64, OBox, Sym, Value, Vec3};
 
 /// What one run gives: the named relations (each sorted, no duplicates) and how many tuples
@@ -109,13 +113,13 @@ tables!(
     builtin_rules::Prog,
     fill_whole,
     read_whole,
-    super::builtin_placed::Prog
+    builtin_placed::Prog
 );
 tables!(
     builtin_plan::Prog,
     fill_plan,
     read_plan,
-    super::builtin_plan_placed::Prog
+    builtin_plan_placed::Prog
 );
 
 /// Whether `builtin_plan` derives every one of `names` as the whole rule base does.
@@ -123,58 +127,10 @@ fn in_plan_scope(names: &[&str]) -> bool {
     names.iter().all(|n| BUILTIN_PLAN_RELATIONS.contains(n))
 }
 
-inputs! {
-    "piece" => r_piece(0: Sym, 1: i64, 2: Sym, 3: Sym);
-    "piece_box" => r_piece_box(0: Sym, 1: OBox);
-    "piece_size" => r_piece_size(0: Sym, 1: F64, 2: F64, 3: F64);
-    "piece_index" => r_piece_index(0: Sym, 1: i64);
-    "piece_type" => r_piece_type(0: Sym, 1: Sym, 2: Sym);
-    "piece_group" => r_piece_group(0: Sym, 1: Sym, 2: Sym, 3: Sym);
-    "piece_container" => r_piece_container(0: Sym, 1: Sym);
-    "piece_material" => r_piece_material(0: Sym, 1: Sym, 2: F64);
-    "contact" => r_contact(0: Sym, 1: Sym, 2: Sym, 3: Sym, 4: Sym, 5: F64, 6: Vec3, 7: Vec3);
-    "crossing" => r_crossing(0: Sym, 1: Sym, 2: F64);
-    "panel_piece" => r_panel_piece(0: Sym, 1: Sym, 2: Sym);
-    "cell_value" => r_cell_value(0: Sym, 1: F64);
-    "cell_choice" => r_cell_choice(0: Sym, 1: Sym);
-    "placement_candidate" => r_placement_candidate(0: Sym, 1: F64);
-    "placement_reaches" => r_placement_reaches(0: Sym, 1: F64, 2: F64);
-    "placement_nail_reaches" => r_placement_nail_reaches(0: Sym, 1: Sym, 2: F64, 3: F64, 4: F64, 5: F64, 6: F64);
-}
-
-// What `plan` (frame::plan::Plan::RELATIONS), the placement search and the plan cache's
-// storey check (`storey_reach`) read.
-outputs! {
-    "wall" => r_wall(0);
-    "wall_of" => r_wall_of(0, 1);
-    "role" => r_role(0, 1);
-    "piece_material" => r_piece_material(0, 1, 2);
-    "piece_size" => r_piece_size(0, 1, 2, 3);
-    "wall_group" => r_wall_group(0, 1, 2, 3);
-    "wall_frame" => r_wall_frame(0, 1);
-    "wall_size" => r_wall_size(0, 1, 2, 3);
-    "assembly_rank" => r_assembly_rank(0, 1);
-    "precedence" => r_precedence(0, 1, 2);
-    "nailing_target" => r_nailing_target(0, 1, 2, 3, 4, 5, 6, 7);
-    "framing_target" => r_framing_target(0, 1);
-    "frame_warning" => r_frame_warning(0, 1);
-    "lumber" => r_lumber(0);
-    "across" => r_across(0, 1);
-    "coplanar" => r_coplanar(0, 1);
-    "storey_reach" => r_storey_reach(0, 1, 2, 3);
-    "panel_limit" => r_panel_limit(0, 1, 2, 3);
-    "wall_split" => r_wall_split(0);
-    "local_box" => r_local_box(0, 1, 2, 3, 4, 5, 6);
-    "cut_at_break" => r_cut_at_break(0);
-    "panel_cap_lap" => r_panel_cap_lap(0);
-    "cut_lapped" => r_cut_lapped(0, 1);
-    "break_allowed" => r_break_allowed(0, 1);
-    "break_added" => r_break_added(0, 1, 2, 3);
-    "break_wanted" => r_break_wanted(0, 1, 2);
-    "break_blocked" => r_break_blocked(0, 1, 2, 3);
-    "placement_target_at_zero" => r_placement_target_at_zero(0, 1);
-    "placement_nail_at_zero" => r_placement_nail_at_zero(0, 1, 2, 3, 4, 5, 6);
-}
+// The `inputs!` (every input but the simulation's records) and `outputs!` (what `plan`
+// (frame::plan::Plan::RELATIONS), the placement search and the plan cache's storey check
+// (`storey_reach`) read) lists, generated from the `.decl`s by `build.rs` (`typed_tables`).
+include!(concat!(env!("OUT_DIR"), "/framing_tables.rs"));
 
 /// Whether `run_selected` takes these inputs and can give these relations.
 pub fn handles(edb: &Relations, wanted: &[&str]) -> bool {
