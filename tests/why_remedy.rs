@@ -21,17 +21,22 @@ fn framewright(args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// The framing cause of the one element `why --json` answers about.
-fn framing_cause(model: &Path, id: &str, offset_x: &str) -> Value {
-    let text = framewright(&[
+/// `why MODEL ID --offset-x X --no-cache`, with `extra` arguments.
+fn why(model: &Path, id: &str, offset_x: &str, extra: &[&str]) -> String {
+    let args = [
         "why",
         model.to_str().unwrap(),
         id,
         "--offset-x",
         offset_x,
         "--no-cache",
-        "--json",
-    ]);
+    ];
+    framewright(&[&args[..], extra].concat())
+}
+
+/// The framing cause of the one element `why --json` answers about.
+fn framing_cause(model: &Path, id: &str, offset_x: &str) -> Value {
+    let text = why(model, id, offset_x, &["--json"]);
     let json: Value = serde_json::from_str(&text).unwrap();
     json["elements"][0]["answer"]["causes"]
         .as_array()
@@ -44,14 +49,7 @@ fn framing_cause(model: &Path, id: &str, offset_x: &str) -> Value {
 
 /// `why`'s framing status of the element with the wall at `offset_x`.
 fn framing_status(model: &Path, id: &str, offset_x: &str) -> String {
-    let text = framewright(&[
-        "why",
-        model.to_str().unwrap(),
-        id,
-        "--offset-x",
-        offset_x,
-        "--no-cache",
-    ]);
+    let text = why(model, id, offset_x, &[]);
     let line = text
         .lines()
         .find(|l| l.starts_with("framing: "))
