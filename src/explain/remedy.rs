@@ -13,8 +13,9 @@
 use super::report::{WhyReport, walk};
 use crate::cell::{Cell, Robot, robot_names};
 use crate::frame::placement::reached_held_at;
+use crate::frame::rows::{FramingTarget, PieceSize, Row, SimIkFailed, WallOffsetX};
 use crate::logic::provenance::Explanation;
-use crate::logic::{Engine, LogicError, Value};
+use crate::logic::{Engine, LogicError};
 use nalgebra::{Isometry3, Translation3, Vector3};
 use serde::Serialize;
 
@@ -74,19 +75,18 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
             &failed.size,
         )
     };
-    let reached = |cell: &Cell, shift: Vector3<f64>| held(cell, shift).is_some();
-    if reached(cell, Vector3::zeros()) {
+    if held(cell, Vector3::zeros()).is_some() {
         return out;
     }
-    let grip = |cell: &Cell, shift: Vector3<f64>| match held(cell, shift) {
-        Some(s) if s != 0.0 => format!(", held {:.2} m off its middle", s.abs()),
-        _ => String::new(),
+    let grip = |s: f64| match s {
+        0.0 => String::new(),
+        s => format!(", held {:.2} m off its middle", s.abs()),
     };
     // The wall stays where the cell lays walls: clear of the robot's base, within its reach.
     let [near, far] = cell.assembly.auto_range;
     let within = |d: f64| (near - 1e-9..=far + 1e-9).contains(&(failed.offset_x + d));
-    match smallest_shift(|d| within(d) && reached(cell, Vector3::x() * d)) {
-        Some(dx) => {
+    match smallest_shift(|d| within(d).then(|| held(cell, Vector3::x() * d))?) {
+        Some((dx, s)) => {
             let value = mm(failed.offset_x + dx);
             out.remedies.push(Remedy {
                 change: "offset_x".into(),
@@ -96,7 +96,7 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
                 text: format!(
                     "lay the wall at offset_x = {value:.3} m ({dx:+.3} m along the robot's x, now {:.3} m{}); {CHECKED_BY}",
                     failed.offset_x,
-                    grip(cell, Vector3::x() * dx)
+                    grip(s)
                 ),
             });
         }
@@ -104,8 +104,8 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
             "no offset_x within the cell's auto_range [{near:.3}, {far:.3}] m"
         )),
     }
-    match smallest_shift(|d| reached(cell, Vector3::y() * d)) {
-        Some(dy) => {
+    match smallest_shift(|d| held(cell, Vector3::y() * d)) {
+        Some((dy, s)) => {
             let now = cell.assembly.centre_y;
             let value = mm(now + dy);
             out.remedies.push(Remedy {
@@ -115,7 +115,7 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
                 checked: true,
                 text: format!(
                     "centre the wall at centre_y = {value:.3} m ({dy:+.3} m along the robot's y, now {now:.3} m{}); {CHECKED_BY}",
-                    grip(cell, Vector3::y() * dy)
+                    grip(s)
                 ),
             });
         }
@@ -123,7 +123,6 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
             .none_found
             .push(format!("no centre_y within ±{SHIFT_LIMIT:.1} m of now")),
     }
-    let mut other_robot = false;
     for name in robot_names() {
         let Ok(mut robot) = Robot::load(name) else {
             continue;
@@ -134,8 +133,7 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
         robot.set_mount(cell.robot.mount);
         let mut other = cell.clone();
         other.robot = robot;
-        if reached(&other, Vector3::zeros()) {
-            other_robot = true;
+        if let Some(s) = held(&other, Vector3::zeros()) {
             let rated = other.robot.meta.reach.unwrap_or(f64::NAN);
             out.remedies.push(Remedy {
                 change: "robot".into(),
@@ -145,12 +143,12 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
                 text: format!(
                     "the {} ({name}, rated reach {rated:.2} m) mounted where this one is{}; {CHECKED_BY}",
                     other.robot.meta.description.as_deref().unwrap_or(name),
-                    grip(&other, Vector3::zeros())
+                    grip(s)
                 ),
             });
         }
     }
-    if !other_robot {
+    if !out.remedies.iter().any(|r| r.change == "robot") {
         out.none_found
             .push("no other shipped robot takes it from this base".into());
     }
@@ -168,14 +166,14 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
     out
 }
 
-/// The smallest move (m, by size, the nearer side first on a tie) in SHIFT_STEP steps up to
-/// SHIFT_LIMIT at which `passes`.
-fn smallest_shift(passes: impl Fn(f64) -> bool) -> Option<f64> {
+/// The smallest move (m, by size, the negative side first on a tie) in SHIFT_STEP steps up to
+/// SHIFT_LIMIT at which `held` gives a grip, with that grip.
+fn smallest_shift(held: impl Fn(f64) -> Option<f64>) -> Option<(f64, f64)> {
     let steps = (SHIFT_LIMIT / SHIFT_STEP).round() as i64;
     (1..=steps)
         .flat_map(|k| [-k, k])
         .map(|k| k as f64 * SHIFT_STEP)
-        .find(|d| passes(*d))
+        .find_map(|d| Some((d, held(d)?)))
 }
 
 /// Rounded to whole millimetres.
@@ -187,33 +185,30 @@ fn mm(v: f64) -> f64 {
 /// refused (`sim_ik_failed(p, "place", …)`), reading the target, size and wall offset from
 /// the engine that explained it.
 pub fn attach(engine: &Engine, cell: &Cell, report: &mut WhyReport) -> Result<(), LogicError> {
-    let piece = report.element.id.clone();
-    let of_piece = |relation: &str| -> Result<Option<Vec<Value>>, LogicError> {
-        if engine.program().relation(relation).is_none() {
+    // The first row of `R` whose key (`key` of the row) is `of`.
+    fn row_of<R: Row>(
+        engine: &Engine,
+        of: &str,
+        key: impl Fn(&R) -> &str,
+    ) -> Result<Option<R>, LogicError> {
+        if engine.program().relation(R::RELATION).is_none() {
             return Ok(None);
         }
         Ok(engine
-            .relation(relation)?
-            .into_iter()
-            .find(|t| t.first().and_then(Value::as_symbol) == Some(piece.as_str())))
-    };
-    let Some(Value::Iso(target)) = of_piece("framing_target")?.and_then(|t| t.get(1).cloned())
-    else {
+            .relation(R::RELATION)?
+            .iter()
+            .filter_map(|t| R::read(t))
+            .find(|r| key(r) == of))
+    }
+    let piece = report.element.id.as_str();
+    let (Some(target), Some(size)) = (
+        row_of::<FramingTarget>(engine, piece, |r| r.p)?,
+        row_of::<PieceSize>(engine, piece, |r| r.p)?,
+    ) else {
         return Ok(());
     };
-    let Some(size) = of_piece("piece_size")?.and_then(|t| {
-        let f = |k: usize| t.get(k).and_then(Value::as_float);
-        Some([f(1)?, f(2)?, f(3)?])
-    }) else {
-        return Ok(());
-    };
-    let wall = report.wall.clone().unwrap_or_default();
-    let offset_x = engine
-        .relation("wall_offset_x")?
-        .into_iter()
-        .find(|t| t.first().and_then(Value::as_symbol) == Some(wall.as_str()))
-        .and_then(|t| t.get(1).and_then(Value::as_float))
-        .unwrap_or(f64::NAN);
+    let wall = report.wall.as_deref().unwrap_or_default();
+    let offset_x = row_of::<WallOffsetX>(engine, wall, |r| r.w)?.map_or(f64::NAN, |r| r.x);
     for cause in report.answer.causes.iter_mut() {
         let Some(verdict) = report.verdicts.get(cause.verdict) else {
             continue;
@@ -224,10 +219,10 @@ pub fn attach(engine: &Engine, cell: &Cell, report: &mut WhyReport) -> Result<()
         let found = remedies(
             cell,
             &FailedPlace {
-                target: target.0,
-                size,
+                target: target.pose,
+                size: [size.length, size.width, size.thickness],
                 offset_x,
-                beyond: failed,
+                beyond: (failed.kind == "out_of_reach").then_some((failed.value, failed.limit)),
             },
         );
         cause.remedies = found.remedies;
@@ -236,19 +231,12 @@ pub fn attach(engine: &Engine, cell: &Cell, report: &mut WhyReport) -> Result<()
     Ok(())
 }
 
-/// Whether a tree rests on a refused place pose: Some(the wrist distance and reach when it
-/// was beyond reach).
-fn place_failure(e: &Explanation) -> Option<Option<(f64, f64)>> {
+/// The refused place pose a tree rests on, if any.
+fn place_failure(e: &Explanation) -> Option<SimIkFailed> {
     let mut found = None;
     walk(e, &mut |node| {
-        let t = &node.tuple;
-        let sym = |k: usize| t.get(k).and_then(Value::as_symbol);
-        if found.is_none() && node.relation == "sim_ik_failed" && sym(1) == Some("place") {
-            let f = |k: usize| t.get(k).and_then(Value::as_float);
-            found = Some(match (sym(2), f(4), f(5)) {
-                (Some("out_of_reach"), Some(d), Some(r)) => Some((d, r)),
-                _ => None,
-            });
+        if found.is_none() && node.relation == SimIkFailed::RELATION {
+            found = SimIkFailed::read(&node.tuple).filter(|f| f.op == "place");
         }
     });
     found
