@@ -7,8 +7,8 @@
 use crate::cell::IkFailure;
 use crate::sim::WallRecord;
 use crate::sim::record::{
-    BeltEvent, ContactRecord, IkRecord, NailOutcome, NailRecord, Op, Operation, Placement, Refusal,
-    RefusalKind,
+    BeltEvent, ContactRecord, IkRecord, NailOutcome, NailRecord, Op, Operation, Placement,
+    PoseRecord, Refusal, RefusalKind, ReleaseRecord, TouchAt, TouchRecord,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
@@ -111,6 +111,10 @@ struct Rec {
     operations: Vec<(String, String, u64, u64)>,
     ik: Vec<(String, String, Result<u64, IkFailureBits>)>,
     contacts: Vec<(String, String, u64, String, String, u64)>,
+    /// piece, op, body a, body b, point, point in the wall, centre a, centre b, depth
+    touches: Vec<TouchBits>,
+    poses: Vec<(String, String, [u64; 3], [u64; 3])>,
+    releases: Vec<(String, String, u64)>,
     placements: Vec<(String, u64, u64)>,
     fed: Vec<(String, u64)>,
     not_fed: Vec<(String, RefusalKind, String)>,
@@ -123,6 +127,8 @@ struct Rec {
     nailing_while_framing: u64,
     steps: u64,
 }
+
+type TouchBits = (String, String, String, String, [[u64; 3]; 4], u64);
 
 #[derive(Serialize, Deserialize)]
 enum IkFailureBits {
@@ -274,6 +280,39 @@ impl From<&WallRecord> for Rec {
                     )
                 })
                 .collect(),
+            touches: r
+                .touches
+                .iter()
+                .map(|t| {
+                    let at = &t.at;
+                    let points = [at.point, at.point_wall, at.centre_a, at.centre_b];
+                    (
+                        t.piece.clone(),
+                        t.op.to_string(),
+                        t.body_a.clone(),
+                        t.body_b.clone(),
+                        points.map(|p| p.map(bits)),
+                        bits(at.depth),
+                    )
+                })
+                .collect(),
+            poses: r
+                .poses
+                .iter()
+                .map(|p| {
+                    (
+                        p.piece.clone(),
+                        p.op.to_string(),
+                        p.centre.map(bits),
+                        p.centre_wall.map(bits),
+                    )
+                })
+                .collect(),
+            releases: r
+                .releases
+                .iter()
+                .map(|x| (x.piece.clone(), x.below.clone(), bits(x.gap)))
+                .collect(),
             placements: r
                 .placements
                 .iter()
@@ -373,6 +412,41 @@ impl Rec {
                 depth: float(depth),
             });
         }
+        let mut touches = Vec::with_capacity(self.touches.len());
+        for (piece, op, body_a, body_b, points, depth) in self.touches {
+            let [point, point_wall, centre_a, centre_b] = points.map(|p| p.map(float));
+            touches.push(TouchRecord {
+                piece,
+                op: Op::from_name(&op)?,
+                body_a,
+                body_b,
+                at: TouchAt {
+                    point,
+                    point_wall,
+                    centre_a,
+                    centre_b,
+                    depth: float(depth),
+                },
+            });
+        }
+        let mut poses = Vec::with_capacity(self.poses.len());
+        for (piece, op, centre, centre_wall) in self.poses {
+            poses.push(PoseRecord {
+                piece,
+                op: Op::from_name(&op)?,
+                centre: centre.map(float),
+                centre_wall: centre_wall.map(float),
+            });
+        }
+        let releases = self
+            .releases
+            .into_iter()
+            .map(|(piece, below, gap)| ReleaseRecord {
+                piece,
+                below,
+                gap: float(gap),
+            })
+            .collect();
         let mut belt_events = Vec::with_capacity(self.belt_events.len());
         for (t, belt, event, piece) in self.belt_events {
             belt_events.push(BeltEvent {
@@ -391,6 +465,9 @@ impl Rec {
             operations,
             ik,
             contacts,
+            touches,
+            poses,
+            releases,
             placements: self
                 .placements
                 .into_iter()
@@ -486,6 +563,30 @@ mod tests {
                 },
             ],
             contacts: vec![],
+            touches: vec![TouchRecord {
+                piece: "p2".into(),
+                op: Op::Pick,
+                body_a: "tool gripper_1_jaws finger".into(),
+                body_b: "piece p1".into(),
+                at: TouchAt {
+                    point: [0.1, -0.0, 1e-9],
+                    point_wall: [3.0, 0.2, f64::MIN_POSITIVE],
+                    centre_a: [1.0, 2.0, 3.0],
+                    centre_b: [-1.0, -2.0, 0.3],
+                    depth: 0.0589,
+                },
+            }],
+            poses: vec![PoseRecord {
+                piece: "p2".into(),
+                op: Op::Place,
+                centre: [2.0, 0.1, 0.95],
+                centre_wall: [1.5, 2.9, -0.045],
+            }],
+            releases: vec![ReleaseRecord {
+                piece: "p1".into(),
+                below: "assembly table".into(),
+                gap: 0.021,
+            }],
             placements: vec![Placement {
                 piece: "p1".into(),
                 position_error: -0.0,

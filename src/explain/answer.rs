@@ -196,6 +196,7 @@ fn cause(
         evidence: lines,
         consequences: Vec::new(),
         verdict: index,
+        located: Vec::new(),
         remedies: Vec::new(),
         no_remedy: Vec::new(),
     }

@@ -8,14 +8,18 @@
 //! or shifted along it as two grippers may hold it); collisions with the cell's fixtures and
 //! with placed pieces are not re-run, and the text says so. The executor may also set a piece
 //! down with the tool tilted, which the check does not try: a remedy is then sufficient, not
-//! always the smallest.
+//! always the smallest. For a piece that came to rest off its target because its target lies
+//! above what is beneath it, the move of its modelled position onto that surface (from the gap
+//! the executor measured at the release; not re-simulated, and said so).
 
+use super::location::Located;
 use super::report::{WhyReport, walk};
 use crate::cell::{Cell, Robot, robot_names};
 use crate::frame::placement::reached_held_at;
 use crate::frame::rows::{FramingTarget, PieceSize, Row, SimIkFailed, WallOffsetX};
 use crate::logic::provenance::Explanation;
 use crate::logic::{Engine, LogicError};
+use crate::sim::RELEASE_GAP;
 use nalgebra::{Isometry3, Translation3, Vector3};
 use serde::Serialize;
 
@@ -23,6 +27,10 @@ use serde::Serialize;
 /// offsets the cell lays walls at (`auto_range`).
 const SHIFT_LIMIT: f64 = 3.0;
 const SHIFT_STEP: f64 = 0.01;
+
+/// A piece released more than this above what lies beneath it (beyond the release gap) is
+/// modelled off its support (m).
+const OFF_SURFACE: f64 = 0.001;
 
 /// The check a remedy was verified by, as the text says it.
 const CHECKED_BY: &str = "checked by IK (place and approach poses, tool pointing down, joint limits, floor; collisions not re-run)";
@@ -200,6 +208,11 @@ pub fn attach(engine: &Engine, cell: &Cell, report: &mut WhyReport) -> Result<()
             .filter_map(|t| R::read(t))
             .find(|r| key(r) == of))
     }
+    for cause in report.answer.causes.iter_mut() {
+        if let Some(r) = off_target_remedy(&cause.located) {
+            cause.remedies.push(r);
+        }
+    }
     let piece = report.element.id.as_str();
     let (Some(target), Some(size)) = (
         row_of::<FramingTarget>(engine, piece, |r| r.p)?,
@@ -229,6 +242,31 @@ pub fn attach(engine: &Engine, cell: &Cell, report: &mut WhyReport) -> Result<()
         cause.no_remedy = found.none_found;
     }
     Ok(())
+}
+
+/// For a piece released above what lies beneath it (more than the executor's release gap):
+/// the move of its modelled position that sets its target on that surface. Computed from the
+/// gap the executor measured beneath it at the release (a shape cast straight down), not
+/// checked by a new simulation.
+fn off_target_remedy(located: &[Located]) -> Option<Remedy> {
+    let (below, gap) = located.iter().find_map(|l| match l {
+        Located::Release { below, gap } if !below.is_empty() => Some((below, *gap)),
+        _ => None,
+    })?;
+    let excess = gap - RELEASE_GAP;
+    if excess < OFF_SURFACE {
+        return None;
+    }
+    Some(Remedy {
+        change: "piece_position".to_string(),
+        value: -mm(excess),
+        unit: "m",
+        checked: false,
+        text: format!(
+            "model it {:.1} mm nearer the surface beneath it as the wall lies ({below}): its framing target lies that far above it, so it drops when released; not checked: computed from the gap measured beneath it at the release",
+            excess * 1000.0
+        ),
+    })
 }
 
 /// The refused place pose a tree rests on, if any.

@@ -17,7 +17,7 @@ const FOLD_AFTER: usize = 3;
 /// Levels of a tree shown on a terminal; deeper facts are counted.
 const MAX_DEPTH: usize = 6;
 /// Levels of a cause's tree under the answer (the rest: `--verbose`).
-const ANSWER_DEPTH: usize = 3;
+const ANSWER_DEPTH: usize = 2;
 /// Nail pairs listed in a consequence's line (all of them: `--json`).
 const PAIRS_SHOWN: usize = 4;
 /// Conditions longer than this (aggregates over boxes) are cut.
@@ -81,6 +81,9 @@ pub fn render_answer(reports: &[WhyReport]) -> String {
                 "{} failed ({}): {what}{}",
                 c.stage, c.component, c.message
             );
+            for l in &c.located {
+                let _ = writeln!(s, "  where: {}", l.text());
+            }
             let _ = writeln!(s, "  by {}", c.rule);
             for q in &c.consequences {
                 let _ = writeln!(s, "  so {} {}: {}", q.count, q.kind, pairs(&q.ids));

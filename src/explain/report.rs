@@ -114,6 +114,8 @@ pub struct Cause {
     pub consequences: Vec<Consequence>,
     /// The verdict (index into the report's `verdicts`) whose tree explains it.
     pub verdict: usize,
+    /// Where it happened, with the numbers (`explain::location`).
+    pub located: Vec<super::location::Located>,
     /// Changes that make it pass, each checked where it says so (`explain::remedy`).
     pub remedies: Vec<super::remedy::Remedy>,
     /// What was searched for a remedy without finding one.

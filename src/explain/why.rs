@@ -198,6 +198,7 @@ pub fn why(ctx: &Context<'_>, id: &str) -> Result<Vec<WhyReport>, WhyError> {
     let mut reports = Vec::new();
     for p in pieces {
         let mut report = why_piece(&engine, p)?;
+        super::location::attach(&engine, &mut report)?;
         if let Some(cell) = ctx.cell {
             super::remedy::attach(&engine, cell, &mut report)?;
         }

@@ -43,6 +43,9 @@ pub struct SimOptions {
 /// The default physics time step, s (240 Hz).
 pub const DEFAULT_DT: f64 = 1.0 / 240.0;
 
+/// A piece is released this far above its framing target and drops into place (m).
+pub const RELEASE_GAP: f64 = 0.001;
+
 /// How the executor advances time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Stepping {

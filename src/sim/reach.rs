@@ -2,9 +2,10 @@
 //! cell frame, straight-line feasibility, and whether the arm, its tool and a held piece
 //! would intersect anything at given joint values (parry queries on the rapier world).
 
-use super::physics::{Physics, to_pose};
+use super::physics::{Physics, to_iso, to_pose};
+use super::record::TouchAt;
 use crate::cell::{Cell, IkFailure};
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Vector3};
 use rapier3d::prelude::*;
 
 /// The largest joint step (rad or m) between two samples of a straight line before the
@@ -132,6 +133,28 @@ pub fn touches(
     ignore: &[&str],
     margin: f64,
 ) -> Option<(String, String)> {
+    touch(phys, cell, q, held, ignore, margin).map(|t| (t.body_a, t.body_b))
+}
+
+/// A touch `touches` finds, with where it is.
+#[derive(Debug, Clone)]
+pub struct Touch {
+    pub body_a: String,
+    pub body_b: String,
+    /// In the cell frame (the wall frame left at zero).
+    pub at: TouchAt,
+}
+
+/// As `touches`, with where the two bodies meet: the deepest point, each body's centre and
+/// the depth (0 where they are only within `margin`).
+pub fn touch(
+    phys: &Physics,
+    cell: &Cell,
+    q: &[f64],
+    held: Option<(&str, &Isometry3<f64>, [f64; 3])>,
+    ignore: &[&str],
+    margin: f64,
+) -> Option<Touch> {
     let world = &phys.world;
     let poses = cell.robot.fk_all(q);
     let tool = cell.robot_base * cell.robot.fk_tip(q);
@@ -147,10 +170,10 @@ pub fn touches(
     };
     let predicate = |h: ColliderHandle, c: &Collider| !skip(h, c);
     let hit = |pose: Isometry3<f64>, shape: &dyn rapier3d::parry::shape::Shape, filter| {
-        world
+        let (h, other) = world
             .intersect_shape(to_pose(&pose), shape, filter)
-            .map(|(h, _)| phys.name(h))
-            .next()
+            .next()?;
+        Some((phys.name(h), where_touching(&pose, shape, other)))
     };
     let body_pose = |body: RigidBodyHandle| -> Option<Isometry3<f64>> {
         if body == phys.tool {
@@ -183,8 +206,12 @@ pub fn touches(
             .predicate(&predicate);
         let dilated = dilate(collider.shape(), margin);
         let shape = dilated.as_ref().map_or(collider.shape(), |s| s.as_ref());
-        if let Some(other) = hit(body * local, shape, filter) {
-            return Some((phys.name(c), other));
+        if let Some((other, at)) = hit(body * local, shape, filter) {
+            return Some(Touch {
+                body_a: phys.name(c),
+                body_b: other,
+                at,
+            });
         }
     }
     if let Some((id, in_tool, half)) = held {
@@ -193,11 +220,47 @@ pub fn touches(
         let h = half.map(|v| ((v - 0.002).max(0.001) + margin.max(0.0)) as f32);
         let shape = Cuboid::new(Vector::new(h[0], h[1], h[2]));
         let filter = QueryFilter::default().predicate(&predicate);
-        if let Some(other) = hit(tool * in_tool, &shape, filter) {
-            return Some((format!("piece {id}"), other));
+        if let Some((other, at)) = hit(tool * in_tool, &shape, filter) {
+            return Some(Touch {
+                body_a: format!("piece {id}"),
+                body_b: other,
+                at,
+            });
         }
     }
     None
+}
+
+/// Where a shape at `pose` meets a collider it intersects: the midpoint of the two shapes'
+/// deepest points, both centres and the depth, in the cell frame.
+fn where_touching(
+    pose: &Isometry3<f64>,
+    shape: &dyn rapier3d::parry::shape::Shape,
+    other: &Collider,
+) -> TouchAt {
+    let centre_a = pose.translation.vector;
+    let centre_b = to_iso(other.position()).translation.vector;
+    let contact = rapier3d::parry::query::contact(
+        &to_pose(pose),
+        shape,
+        other.position(),
+        other.shape(),
+        0.0,
+    )
+    .ok()
+    .flatten();
+    // A pair parry cannot measure: its centres' midpoint, depth unknown (0).
+    let (point, depth) = contact.map_or(((centre_a + centre_b) / 2.0, 0.0), |c| {
+        let p = |v: rapier3d::math::Vector| Vector3::new(v.x, v.y, v.z).cast::<f64>();
+        ((p(c.point1) + p(c.point2)) / 2.0, -f64::from(c.dist))
+    });
+    TouchAt {
+        point: point.into(),
+        point_wall: [0.0; 3],
+        centre_a: centre_a.into(),
+        centre_b: centre_b.into(),
+        depth: depth.max(0.0),
+    }
 }
 
 /// The shape grown by `margin` on every side (its Minkowski sum with a ball), for the shapes

@@ -90,6 +90,48 @@ pub struct ContactRecord {
     pub depth: f64,
 }
 
+/// Where two bodies met: the deepest point in the cell frame and the wall's frame (u along the
+/// wall, v up it, w through it), each body's centre in the cell frame then, and how deep one
+/// went into the other (m).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct TouchAt {
+    pub point: [f64; 3],
+    pub point_wall: [f64; 3],
+    pub centre_a: [f64; 3],
+    pub centre_b: [f64; 3],
+    pub depth: f64,
+}
+
+/// Where a touch of two bodies happened while working on a piece: a contact during an
+/// operation (at its deepest), or the collision that ruled out the pose an operation needed.
+#[derive(Debug, Clone, Serialize)]
+pub struct TouchRecord {
+    pub piece: String,
+    pub op: Op,
+    pub body_a: String,
+    pub body_b: String,
+    pub at: TouchAt,
+}
+
+/// Where the piece's centre would have been at the pose an operation needed, for an operation
+/// the arm could not take: cell frame and wall frame (m).
+#[derive(Debug, Clone, Serialize)]
+pub struct PoseRecord {
+    pub piece: String,
+    pub op: Op,
+    pub centre: [f64; 3],
+    pub centre_wall: [f64; 3],
+}
+
+/// What lay beneath a piece when the gripper let go of it, and how far below its underside
+/// (m): a piece released above its support drops that far.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReleaseRecord {
+    pub piece: String,
+    pub below: String,
+    pub gap: f64,
+}
+
 /// A placed piece's rest pose against its target.
 #[derive(Debug, Clone, Serialize)]
 pub struct Placement {
@@ -194,6 +236,12 @@ pub struct WallRecord {
     pub operations: Vec<Operation>,
     pub ik: Vec<IkRecord>,
     pub contacts: Vec<ContactRecord>,
+    /// Where the contacts and the collisions that ruled out a pose happened.
+    pub touches: Vec<TouchRecord>,
+    /// Where the pieces would have been at the poses the arm could not take.
+    pub poses: Vec<PoseRecord>,
+    /// What lay beneath each released piece.
+    pub releases: Vec<ReleaseRecord>,
     pub placements: Vec<Placement>,
     pub fed: Vec<(String, f64)>,
     /// Pieces the belts did not bring to the sensor, and why.
@@ -489,6 +537,74 @@ impl WallRecord {
                     "contact {} / {} at t = {:.3} s",
                     c.body_a, c.body_b, c.t
                 )),
+            );
+        }
+        for r in &self.touches {
+            let origin = || {
+                event(&format!(
+                    "{} of {}: {} / {}",
+                    r.op, r.piece, r.body_a, r.body_b
+                ))
+            };
+            let (at, [u, v, w]) = (&r.at, r.at.point_wall);
+            let [x, y, z] = at.point;
+            facts.add(
+                "sim_touch",
+                vec![
+                    s(&r.piece),
+                    s(r.op.name()),
+                    s(&r.body_a),
+                    s(&r.body_b),
+                    f(at.depth),
+                    f(x),
+                    f(y),
+                    f(z),
+                    f(u),
+                    f(v),
+                    f(w),
+                ],
+                origin(),
+            );
+            let ([ax, ay, az], [bx, by, bz]) = (at.centre_a, at.centre_b);
+            facts.add(
+                "sim_touch_centres",
+                vec![
+                    s(&r.piece),
+                    s(r.op.name()),
+                    s(&r.body_a),
+                    s(&r.body_b),
+                    f(ax),
+                    f(ay),
+                    f(az),
+                    f(bx),
+                    f(by),
+                    f(bz),
+                ],
+                origin(),
+            );
+        }
+        for p in &self.poses {
+            let ([x, y, z], [u, v, w]) = (p.centre, p.centre_wall);
+            facts.add(
+                "sim_pose",
+                vec![
+                    s(&p.piece),
+                    s(p.op.name()),
+                    f(x),
+                    f(y),
+                    f(z),
+                    f(u),
+                    f(v),
+                    f(w),
+                ],
+                event(&format!("{} pose of {}", p.op, p.piece)),
+            );
+        }
+        for r in &self.releases {
+            facts.add(
+                "sim_released",
+                vec![s(&r.piece), s(&r.below), f(r.gap)],
+                event(&format!("release of {}", r.piece)),
             );
         }
         for p in &self.placements {

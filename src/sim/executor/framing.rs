@@ -4,18 +4,18 @@ use super::paths::distance;
 use super::{Held, WallRun, failure_score, raise};
 use crate::cell::tcp_poses::{GRIP_SHIFT_STEP, two_gripper_reach, two_gripper_shifts};
 use crate::cell::{Arrangement, Hold, IkFailure};
+use crate::sim::RELEASE_GAP;
 use crate::sim::motion::LinearMove;
 use crate::sim::physics::GRAVITY;
-use crate::sim::reach::{continuous_line, reach_margin, solve, touches};
-use crate::sim::record::Op;
-use crate::sim::record::{IkRecord, Refusal, RefusalKind, RobotStep, StepFor};
+use crate::sim::reach::{Touch, continuous_line, reach_margin, solve, touch};
+use crate::sim::record::{
+    IkRecord, Op, PoseRecord, Refusal, RefusalKind, ReleaseRecord, RobotStep, StepFor, TouchRecord,
+};
 use crate::world::ScenePiece;
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// Height above the pick and place poses the gripper approaches from (m).
 pub(super) const CLEARANCE: f64 = 0.25;
-/// A piece is released this far above its target and drops into place (m).
-pub(super) const RELEASE_GAP: f64 = 0.001;
 /// A piece more than this far from where the plan expected it when the jaws close is not
 /// held (m).
 /// Samples checked along a straight descent while planning.
@@ -26,6 +26,40 @@ pub(super) const GRIP_TOLERANCE: f64 = 0.005;
 pub(super) const SENSOR_SETTLE: f64 = 0.5;
 /// The longest the executor waits for a piece at the sensor to come to rest (s).
 pub(super) const MAX_SENSOR_SETTLE: f64 = 3.0;
+
+/// How far below a released piece the executor looks for what it will rest on (m).
+const RELEASE_LOOK_DOWN: f64 = 1.0;
+
+/// Why a framing could not be planned: the operation whose pose failed, how, and for a pose
+/// ruled out by a collision, where the two bodies met.
+pub(super) struct Miss {
+    op: Op,
+    failure: IkFailure,
+    /// Boxed: a miss is passed around often, a touch rarely.
+    touch: Option<Box<Touch>>,
+}
+
+impl Miss {
+    fn colliding(op: Op, t: Touch) -> Miss {
+        Miss {
+            op,
+            failure: IkFailure::AllSolutionsCollide {
+                pair: [t.body_a.clone(), t.body_b.clone()],
+            },
+            touch: Some(Box::new(t)),
+        }
+    }
+}
+
+impl From<(Op, IkFailure)> for Miss {
+    fn from((op, failure): (Op, IkFailure)) -> Miss {
+        Miss {
+            op,
+            failure,
+            touch: None,
+        }
+    }
+}
 
 /// A planned framing: the grip and the joint values of its four poses.
 struct FramingPlan {
@@ -102,12 +136,8 @@ impl<'a> WallRun<'a> {
         }
         let plan = match self.plan_framing(piece) {
             Ok(plan) => plan,
-            Err((op, failure)) => {
-                self.record.ik.push(IkRecord {
-                    piece: piece.id.clone(),
-                    op,
-                    result: Err(failure),
-                });
+            Err(miss) => {
+                self.record_miss(piece, miss);
                 self.take_off(&piece.id);
                 return;
             }
@@ -285,6 +315,7 @@ impl<'a> WallRun<'a> {
                 .is_ok();
         if ok {
             self.record_grip(piece, &grip);
+            self.record_release(id);
         }
         self.phys.set_jaws(None);
         self.phys.detach(id);
@@ -341,6 +372,19 @@ impl<'a> WallRun<'a> {
         self.move_to(&q_above, grip, &[], self.transfer_speed())
     }
 
+    /// What lies beneath the piece the gripper is about to let go of, and how far down.
+    fn record_release(&mut self, id: &str) {
+        let (below, gap) = self
+            .phys
+            .below(id, RELEASE_LOOK_DOWN)
+            .unwrap_or((String::new(), 0.0));
+        self.record.releases.push(ReleaseRecord {
+            piece: id.to_string(),
+            below,
+            gap,
+        });
+    }
+
     /// Where the grip TCP holds `piece` at its release: metres along the piece from its
     /// target's centre, positive towards its upper end (a piece running up the wall) or its
     /// larger-u end, as `plan` orders a member's axis.
@@ -361,10 +405,39 @@ impl<'a> WallRun<'a> {
     /// A straight move of a framing that failed on the way: recorded against the piece, so
     /// that it is not placed without a reason.
     fn record_line_failure(&mut self, piece: &ScenePiece, op: Op, failure: IkFailure) {
+        self.record_miss(piece, Miss::from((op, failure)));
+    }
+
+    /// A pose the arm could not take: the failure, where the piece would have been, and
+    /// where the collision that ruled it out lay.
+    fn record_miss(&mut self, piece: &ScenePiece, miss: Miss) {
+        let centre = match miss.op {
+            Op::Pick => self.phys.lumber_pose(&piece.id).unwrap_or(piece.spawn),
+            _ => piece.target_cell,
+        }
+        .translation
+        .vector;
+        let in_wall = self.wall_cell.inverse() * Point3::from(centre);
+        self.record.poses.push(PoseRecord {
+            piece: piece.id.clone(),
+            op: miss.op,
+            centre: centre.into(),
+            centre_wall: in_wall.coords.into(),
+        });
+        if let Some(t) = miss.touch.map(|t| *t) {
+            let at = self.in_wall(t.at);
+            self.record.touches.push(TouchRecord {
+                piece: piece.id.clone(),
+                op: miss.op,
+                body_a: t.body_a,
+                body_b: t.body_b,
+                at,
+            });
+        }
         self.record.ik.push(IkRecord {
             piece: piece.id.clone(),
-            op,
-            result: Err(failure),
+            op: miss.op,
+            result: Err(miss.failure),
         });
     }
 
@@ -486,19 +559,19 @@ impl<'a> WallRun<'a> {
     /// (a box fits its target four ways) whose pick and place poses the arm reaches, preferring
     /// a tool pointing down, poses clear of other bodies and short joint travel. Err: the
     /// operation and failure of the closest miss.
-    fn plan_framing(&self, piece: &ScenePiece) -> Result<FramingPlan, (Op, IkFailure)> {
+    fn plan_framing(&self, piece: &ScenePiece) -> Result<FramingPlan, Miss> {
         let grip = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
         let body = self.phys.lumber_pose(&piece.id).unwrap_or(piece.spawn);
         let along = self.cell.conveyor2.direction();
         let mut best: Option<(f64, FramingPlan)> = None;
-        let mut miss: Option<(f64, Op, IkFailure)> = None;
-        let mut note_miss = |op, f: IkFailure| {
+        let mut miss: Option<(f64, Miss)> = None;
+        let mut note_miss = |m: Miss| {
             // A grip whose pick fails got less far than one whose place fails: report the
             // place miss when there is one (a long plate's middle may lie beyond reach on the
             // belt, but that is not why it cannot be framed).
-            let score = failure_score(&f) + if op == Op::Pick { 100.0 } else { 0.0 };
-            if miss.as_ref().is_none_or(|m| score < m.0) {
-                miss = Some((score, op, f));
+            let score = failure_score(&m.failure) + if m.op == Op::Pick { 100.0 } else { 0.0 };
+            if miss.as_ref().is_none_or(|best| score < best.0) {
+                miss = Some((score, m));
             }
         };
         // The study grips at the centre of mass; where the arm cannot pick or place a piece
@@ -563,15 +636,13 @@ impl<'a> WallRun<'a> {
                     let held_in_tool = grip * in_body.inverse();
                     let half = piece.size.map(|v| v / 2.0);
                     let held = Some((piece.id.as_str(), &held_in_tool, half));
-                    if let Some((a, b)) = touches(&self.phys, &at_place, &q_place, held, &[], 0.0) {
-                        return Err((Op::Place, IkFailure::AllSolutionsCollide { pair: [a, b] }));
+                    if let Some(t) = touch(&self.phys, &at_place, &q_place, held, &[], 0.0) {
+                        return Err(Miss::colliding(Op::Place, t));
                     }
-                    if let Some((a, b)) =
-                        touches(&self.phys, &at_pick, &q_pick, None, &[&piece.id], 0.0)
-                    {
-                        return Err((Op::Pick, IkFailure::AllSolutionsCollide { pair: [a, b] }));
+                    if let Some(t) = touch(&self.phys, &at_pick, &q_pick, None, &[&piece.id], 0.0) {
+                        return Err(Miss::colliding(Op::Pick, t));
                     }
-                    Ok::<_, (Op, IkFailure)>(FramingPlan {
+                    Ok::<_, Miss>(FramingPlan {
                         pick_body: body,
                         pick_margin: reach_margin(&at_pick, &pick, &grip),
                         place_margin: reach_margin(&at_place, &place, &grip),
@@ -585,7 +656,7 @@ impl<'a> WallRun<'a> {
                     })
                 })();
                 match attempt {
-                    Err((op, f)) => note_miss(op, f),
+                    Err(m) => note_miss(m),
                     Ok(plan) => {
                         // Joint travel (rad) and carriage travel (m) alike count as travel.
                         let travel = distance(&self.q, &plan.q_above_pick)
@@ -602,8 +673,8 @@ impl<'a> WallRun<'a> {
         }
         match (best, miss) {
             (Some((_, plan)), _) => Ok(plan),
-            (None, Some((_, op, f))) => Err((op, f)),
-            (None, None) => Err((Op::Place, IkFailure::InvalidPose)),
+            (None, Some((_, m))) => Err(m),
+            (None, None) => Err(Miss::from((Op::Place, IkFailure::InvalidPose))),
         }
     }
 }

@@ -24,7 +24,9 @@ use super::SimOptions;
 use super::motion::{JointMove, LinearMove};
 use super::physics::Physics;
 use super::reach::{check_step, solve};
-use super::record::{ContactRecord, Op, Operation, RobotStep, StepFor, WallRecord};
+use super::record::{
+    ContactRecord, Op, Operation, RobotStep, StepFor, TouchAt, TouchRecord, WallRecord,
+};
 use crate::cell::{Cell, IkFailure};
 use crate::world::{ScenePiece, SceneWall};
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
@@ -68,7 +70,9 @@ pub struct WallRun<'a> {
     current: Option<(String, Op, Vec<String>)>,
     /// Robot/fixed pairs touching at the start (a base on its floor): never reported.
     resting: BTreeSet<(String, String)>,
-    contacts: BTreeMap<(String, Op, String, String), (f64, f64)>,
+    /// Per piece, operation and pair of bodies: the first time they touched, and where at
+    /// the deepest.
+    contacts: BTreeMap<(String, Op, String, String), (f64, TouchAt)>,
     /// Pieces not yet put on conveyor 1, in order.
     queue: VecDeque<&'a ScenePiece>,
     /// Pieces on the belts (spawned, not yet picked or removed).
@@ -208,17 +212,24 @@ impl<'a> WallRun<'a> {
         self.measure(nails);
         self.record.trace.finish();
         (self.progress)(total, total);
-        self.record.contacts = std::mem::take(&mut self.contacts)
-            .into_iter()
-            .map(|((piece, op, a, b), (t, depth))| ContactRecord {
+        for ((piece, op, a, b), (t, at)) in std::mem::take(&mut self.contacts) {
+            self.record.touches.push(TouchRecord {
+                piece: piece.clone(),
+                op,
+                body_a: a.clone(),
+                body_b: b.clone(),
+                at,
+            });
+            self.record.contacts.push(ContactRecord {
                 piece,
                 op,
                 t,
                 body_a: a,
                 body_b: b,
-                depth,
-            })
-            .collect();
+                depth: at.depth,
+            });
+        }
+
         Ok(self.record)
     }
 
@@ -375,16 +386,26 @@ impl<'a> WallRun<'a> {
             return;
         }
         let held = self.held.as_ref().map(|h| h.id.as_str());
-        for (a, b, depth) in self.phys.robot_contacts(held, CONTACT_TOLERANCE) {
+        for (a, b, at) in self.phys.robot_contacts(held, CONTACT_TOLERANCE) {
             if allowed.contains(&b) || self.resting.contains(&(a.clone(), b.clone())) {
                 continue;
             }
+            let at = self.in_wall(at);
             let entry = self
                 .contacts
                 .entry((piece.clone(), *op, a, b))
-                .or_insert((self.t, depth));
-            entry.1 = entry.1.max(depth);
+                .or_insert((self.t, at));
+            if at.depth > entry.1.depth {
+                entry.1 = at;
+            }
         }
+    }
+
+    /// A touch with its point also in the wall's frame.
+    pub(super) fn in_wall(&self, mut at: TouchAt) -> TouchAt {
+        let p = self.wall_cell.inverse() * Point3::from(at.point);
+        at.point_wall = [p.x, p.y, p.z];
+        at
     }
 }
 

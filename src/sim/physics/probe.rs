@@ -6,6 +6,10 @@ use crate::cell::JointKind;
 use nalgebra::{Isometry3, Vector3};
 use rapier3d::prelude::*;
 
+/// How far a piece's box is shrunk on every side when looking for what lies beneath it (m):
+/// pieces abutting it side by side are not beneath it.
+const BESIDE: f64 = 0.002;
+
 /// Which touches a caller records: a clearance's `any` measures how far the robot is from
 /// the first of them (lumber that can move is always measured: the robot may push it).
 #[derive(Debug, Clone, Copy)]
@@ -318,10 +322,50 @@ impl Physics {
         ids
     }
 
+    /// What lies beneath piece `id` as it is now, within `max` (m) straight down: the first
+    /// body its box would meet falling (the robot, the tool and sensors aside) and the gap
+    /// between them (m).
+    pub fn below(&self, id: &str, max: f64) -> Option<(String, f64)> {
+        let b = self.lumber.get(id)?;
+        let pose = self.lumber_pose(id)?;
+        let collider = &self.world.colliders[b.collider];
+        let own = |body: RigidBodyHandle| {
+            body == b.body || body == self.tool || self.links.iter().any(|l| l.1 == body)
+        };
+        let predicate =
+            |_: ColliderHandle, c: &Collider| !c.is_sensor() && !c.parent().is_some_and(own);
+        let filter = QueryFilter::default().predicate(&predicate);
+        let options = rapier3d::parry::query::ShapeCastOptions::with_max_time_of_impact(max as f32);
+        // The box shrunk on every side, so that neighbours it abuts side by side do not count
+        // as beneath it; its underside rises by the shrink times the axes' vertical parts.
+        let half = collider.shape().as_cuboid()?.half_extents;
+        let shrink = BESIDE;
+        let shape = Cuboid::new(half - Vector::splat(shrink as f32));
+        let rise: f64 = (0..3)
+            .map(|i| (pose.rotation * Vector3::ith(i, 1.0)).z.abs() * shrink)
+            .sum();
+        let (h, hit) = self.world.cast_shape(
+            &to_pose(&pose),
+            Vector::new(0.0, 0.0, -1.0),
+            &shape,
+            options,
+            filter,
+        )?;
+        Some((
+            self.name(h),
+            (f64::from(hit.time_of_impact) - rise).max(0.0),
+        ))
+    }
+
     /// Contacts of the robot, its tool and the piece `held` with anything else, deeper than
-    /// `tolerance` (any depth between the arm or tool and lumber): (body, other body, depth),
-    /// excluding the held piece against the tool.
-    pub fn robot_contacts(&self, held: Option<&str>, tolerance: f64) -> Vec<(String, String, f64)> {
+    /// `tolerance` (any depth between the arm or tool and lumber): (body, other body, where:
+    /// the deepest point and the two bodies' centres in the cell frame, the depth), excluding
+    /// the held piece against the tool.
+    pub fn robot_contacts(
+        &self,
+        held: Option<&str>,
+        tolerance: f64,
+    ) -> Vec<(String, String, crate::sim::record::TouchAt)> {
         let held_collider = held.and_then(|id| self.lumber.get(id)).map(|b| b.collider);
         let mut found = Vec::new();
         let mut sources = self.robot_colliders.clone();
@@ -348,7 +392,28 @@ impl Physics {
                     tolerance
                 };
                 if depth > limit {
-                    found.push((self.name(c), self.name(other), depth));
+                    let colliders = &self.world.colliders;
+                    let world_point = |h: ColliderHandle, local: Vector| {
+                        to_iso(colliders[h].position())
+                            * nalgebra::Point3::new(local.x, local.y, local.z).cast::<f64>()
+                    };
+                    let centre = |h: ColliderHandle| {
+                        let t = to_iso(colliders[h].position()).translation.vector;
+                        [t.x, t.y, t.z]
+                    };
+                    // Midway between the two shapes' deepest points.
+                    let mid = nalgebra::center(
+                        &world_point(pair.collider1, contact.local_p1),
+                        &world_point(pair.collider2, contact.local_p2),
+                    );
+                    let at = crate::sim::record::TouchAt {
+                        point: [mid.x, mid.y, mid.z],
+                        point_wall: [0.0; 3],
+                        centre_a: centre(c),
+                        centre_b: centre(other),
+                        depth,
+                    };
+                    found.push((self.name(c), self.name(other), at));
                 }
             }
         }

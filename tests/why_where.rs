@@ -1,0 +1,232 @@
+//! `why` gives each failure's numbers of where: the pose a piece would have taken (cell and
+//! wall frames), the two bodies that touched with their centres and the depth, and for a piece
+//! that came to rest off its target what lay beneath it when released and how far below. The
+//! expected numbers come from the model and the tool as written, worked out by hand.
+
+mod common;
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn framewright(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn tm3() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc")
+}
+
+/// TM3 with stud F-016 (#145) modelled `dy` m across the wall from where it is.
+fn tm3_stud_moved(dir: &Path, dy: f64) -> PathBuf {
+    let text = std::fs::read_to_string(tm3()).unwrap();
+    let at = "#139=IFCCARTESIANPOINT((1.1684,0.04445,0.0381));";
+    assert!(text.contains(at), "TM3's stud F-016 moved in the model");
+    let moved = text.replace(
+        at,
+        &format!("#139=IFCCARTESIANPOINT((1.1684,{},0.0381));", 0.04445 + dy),
+    );
+    let path = dir.join("tm3_stud_moved.ifc");
+    std::fs::write(&path, moved).unwrap();
+    path
+}
+
+/// The framing cause `why --json` gives for the one element.
+fn framing_cause(model: &Path, id: &str, extra: &[&str]) -> Value {
+    let args = [&["why", model.to_str().unwrap(), id, "--json"][..], extra].concat();
+    let json: Value = serde_json::from_str(&framewright(&args)).unwrap();
+    json["elements"][0]["answer"]["causes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["stage"] == "framing")
+        .cloned()
+        .unwrap_or_else(|| panic!("no framing cause: {json}"))
+}
+
+fn located<'c>(cause: &'c Value, kind: &str) -> Vec<&'c Value> {
+    cause["located"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|l| l["kind"] == kind)
+        .collect()
+}
+
+fn xyz(v: &Value) -> [f64; 3] {
+    let a = v.as_array().unwrap();
+    [0, 1, 2].map(|i| a[i].as_f64().unwrap())
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+#[test]
+fn a_place_pose_beyond_reach_is_where_the_model_puts_the_piece() {
+    // Stud F-016: IfcLocalPlacement at (1.1684, 0.04445, 0.0381), extruded 2.352675 m up.
+    // TM3's wall runs from x = 6.858 along -x (its placement #28: origin #25, axis #27 = (-1, 0, 0)); its frame: u from
+    // that start, v up from z = 0, w across from the face at y = 0 (docs/RELATIONS.md). So the
+    // stud's centre is at u = 6.858 - 1.1684, v = 0.0381 + 2.352675 / 2, w = 0.04445.
+    let cause = framing_cause(&tm3(), "2nv91WmrtNJ_0CsN4f5WS5", &["--no-cache"]);
+    assert!(
+        cause["message"].as_str().unwrap().contains("beyond reach"),
+        "{cause}"
+    );
+    let poses = located(&cause, "pose");
+    assert_eq!(poses.len(), 1, "{cause}");
+    assert_eq!(poses[0]["op"], "place");
+    let wall = xyz(&poses[0]["wall"]);
+    let modelled = [6.858 - 1.1684, 0.0381 + 2.352675 / 2.0, 0.04445];
+    assert!(dist(wall, modelled) < 1e-4, "{wall:?} vs {modelled:?}");
+    // Laid flat on the table, the wall's w is the cell's height: both frames agree on it.
+    let cell = xyz(&poses[0]["cell"]);
+    assert!((cell[2] - wall[2]).abs() < 1e-4, "{cell:?} / {wall:?}");
+}
+
+#[test]
+fn a_piece_modelled_above_its_support_says_how_far_it_dropped_and_onto_what() {
+    // Stud F-016 moved 20 mm across the wall (out of its plane): laid flat, its target lies
+    // 20 mm above what it should rest on; the executor releases it 1 mm above its target, so
+    // it is let go 21 mm above the surface and drops onto it. At offset_x 0.742 the arm
+    // reaches it (TM3's own remedy for this stud).
+    let dir = tempfile::tempdir().unwrap();
+    let model = tm3_stud_moved(dir.path(), 0.020);
+    let cause = framing_cause(
+        &model,
+        "2nv91WmrtNJ_0CsN4f5WS5",
+        &["--offset-x", "0.742", "--no-cache"],
+    );
+    assert!(
+        cause["message"]
+            .as_str()
+            .unwrap()
+            .starts_with("came to rest "),
+        "{cause}"
+    );
+    let releases = located(&cause, "release");
+    assert_eq!(releases.len(), 1, "{cause}");
+    let gap = releases[0]["gap"].as_f64().unwrap();
+    assert!((gap - 0.021).abs() < 0.001, "released {gap} m above");
+    assert!(!releases[0]["below"].as_str().unwrap().is_empty());
+    // The remedy moves the piece back by what it is off, not checked by a simulation.
+    let remedy = cause["remedies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["change"] == "piece_position")
+        .unwrap_or_else(|| panic!("no remedy: {cause}"));
+    assert!(
+        (remedy["value"].as_f64().unwrap() + 0.020).abs() < 0.001,
+        "{remedy}"
+    );
+    assert_eq!(remedy["checked"], false);
+    // The text says it in the first lines.
+    let text = framewright(&[
+        "why",
+        model.to_str().unwrap(),
+        "2nv91WmrtNJ_0CsN4f5WS5",
+        "--offset-x",
+        "0.742",
+    ]);
+    let head: Vec<&str> = text.lines().take(8).collect();
+    assert!(
+        head.iter()
+            .any(|l| l.contains("where: released 21.0 mm above")),
+        "{text}"
+    );
+}
+
+#[test]
+fn where_survives_the_cache() {
+    // A `why` answered from the cached simulation gives the same numbers of where.
+    let dir = tempfile::tempdir().unwrap();
+    let model = tm3_stud_moved(dir.path(), 0.020);
+    let cache = dir.path().join("cache");
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "why".to_string(),
+            model.to_str().unwrap().to_string(),
+            "2nv91WmrtNJ_0CsN4f5WS5".to_string(),
+            "--offset-x".to_string(),
+            "0.742".to_string(),
+            "--cache-dir".to_string(),
+            cache.to_str().unwrap().to_string(),
+        ];
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let run = |extra: &[&str]| {
+        let a = args(extra);
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        framewright(&refs)
+    };
+    let wheres = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| l.trim_start().starts_with("where: "))
+            .map(str::to_string)
+            .collect()
+    };
+    let fresh = run(&[]);
+    let cached = run(&[]);
+    assert!(cached.contains("(from the cache)"), "{cached}");
+    assert!(!wheres(&fresh).is_empty(), "{fresh}");
+    assert_eq!(wheres(&fresh), wheres(&cached));
+}
+
+#[test]
+fn a_collision_names_both_bodies_where_they_are_and_how_deep() {
+    // The Constructivity wall on the study's ABB cell: a cripple's place pose is ruled out
+    // because a finger of the tool meets its neighbour, and another cripple's jaws touch a
+    // piece while placing it.
+    let Some(model) =
+        common::shared_path("ifc-realworld/timber_constructivity_wall-elemented-case_IFC4.ifc")
+    else {
+        return;
+    };
+    let cause = framing_cause(&model, "0y81T5OQ921PKefugNkz2z/9", &["--no-cache"]);
+    let touches = located(&cause, "touch");
+    assert!(!touches.is_empty(), "{cause}");
+    for t in &touches {
+        let depth = t["depth"].as_f64().unwrap();
+        assert!(depth > 0.0, "{t}");
+        assert!(t["body_a"].as_str().unwrap().contains("finger"), "{t}");
+        assert!(t["body_b"].as_str().unwrap().starts_with("piece "), "{t}");
+    }
+    // Both grippers' fingers touched: their centres lie the tool's gripper spacing apart
+    // (0.60 m, `spacing` in robots/tools/study-gripper-nailer.toml), and the two points of contact are one rigid motion apart in
+    // both frames (the wall frame is the cell frame moved).
+    let fingers: Vec<&&Value> = touches
+        .iter()
+        .filter(|t| t["body_a"].as_str().unwrap().contains("gripper"))
+        .collect();
+    if fingers.len() == 2 {
+        let (a, b) = (fingers[0], fingers[1]);
+        let apart = dist(xyz(&a["centre_a"]), xyz(&b["centre_a"]));
+        assert!((apart - 0.6).abs() < 0.005, "fingers {apart} m apart");
+        let in_cell = dist(xyz(&a["cell"]), xyz(&b["cell"]));
+        let in_wall = dist(xyz(&a["wall"]), xyz(&b["wall"]));
+        assert!((in_cell - in_wall).abs() < 1e-6, "{in_cell} vs {in_wall}");
+    }
+    // A pose ruled out by a collision: where the piece would have been, and the touch.
+    let cause = framing_cause(&model, "0y81T5OQ921PKefugNkz2z/12", &["--no-cache"]);
+    assert_eq!(located(&cause, "pose").len(), 1, "{cause}");
+    let touch = located(&cause, "touch");
+    assert_eq!(touch.len(), 1, "{cause}");
+    let message = cause["message"].as_str().unwrap();
+    assert!(
+        message.contains(touch[0]["body_a"].as_str().unwrap())
+            && message.contains(touch[0]["body_b"].as_str().unwrap()),
+        "{message} / {}",
+        touch[0]
+    );
+}
