@@ -183,9 +183,14 @@ fn corpus_programs_give_their_documented_outputs_on_both_engines() {
         progs.len(),
         interpreter_only.join("\n  ")
     );
-    // Every corpus program runs on both engines.
+    // Every corpus program runs on both engines, but those using `autoinc()`: its numbers
+    // follow the interpreter's evaluation order, and the code generator refuses it by name.
+    let unexpected: Vec<&String> = interpreter_only
+        .iter()
+        .filter(|why| !why.contains("autoinc() is interpreter-only"))
+        .collect();
     assert!(
-        interpreter_only.is_empty(),
+        unexpected.len() < interpreter_only.len() && unexpected.is_empty(),
         "interpreter only:\n{}",
         interpreter_only.join("\n")
     );

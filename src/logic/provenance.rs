@@ -432,7 +432,7 @@ fn eval_const(
     fn uses_unbound(e: &CExpr, bound: &[bool]) -> bool {
         match e {
             CExpr::Slot(s) => !bound[*s as usize],
-            CExpr::Const(_) => false,
+            CExpr::Const(_) | CExpr::Autoinc(_) => false,
             CExpr::Neg(_, x) => uses_unbound(x, bound),
             CExpr::Bin(_, _, a, b) => uses_unbound(a, bound) || uses_unbound(b, bound),
             CExpr::Builtin(_, _, args) | CExpr::Ext(_, args) => {

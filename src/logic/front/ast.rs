@@ -136,10 +136,12 @@ pub enum Builtin {
     Utof,
     Ftoi,
     Ftou,
+    /// `autoinc()`: the next number of the run's counter (from 0).
+    Autoinc,
 }
 
 impl Builtin {
-    pub const ALL: [Builtin; 16] = [
+    pub const ALL: [Builtin; 17] = [
         Builtin::Min,
         Builtin::Max,
         Builtin::Cat,
@@ -156,6 +158,7 @@ impl Builtin {
         Builtin::Utof,
         Builtin::Ftoi,
         Builtin::Ftou,
+        Builtin::Autoinc,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -175,6 +178,7 @@ impl Builtin {
             Builtin::Utof => "utof",
             Builtin::Ftoi => "ftoi",
             Builtin::Ftou => "ftou",
+            Builtin::Autoinc => "autoinc",
         }
     }
     pub fn from_name(name: &str) -> Option<Builtin> {

@@ -629,6 +629,12 @@ impl Gen<'_> {
                     (_, BinOp::Pow) => format!("crate::logic::ops::pow_i64({x}, {y})"),
                 }
             }
+            ExprKind::Builtin(Builtin::Autoinc, _) => {
+                return Err(CodegenError::new(
+                    b,
+                    "autoinc() is interpreter-only: its numbers follow the interpreter's evaluation order",
+                ));
+            }
             ExprKind::Builtin(bi, args) => {
                 let a: Vec<String> = args
                     .iter()
@@ -676,6 +682,7 @@ impl Gen<'_> {
                     Builtin::Utof => format!("F64(({}) as f64)", a[0]),
                     Builtin::Ftoi => format!("(({}).0 as i64)", a[0]),
                     Builtin::Ftou => format!("(({}).0 as u64)", a[0]),
+                    Builtin::Autoinc => unreachable!("refused above"),
                 }
             }
             ExprKind::Ext(name, args) => {

@@ -7,6 +7,8 @@ use crate::logic::front::ast::*;
 use crate::logic::functors::{self, Functor};
 use crate::logic::value::Value;
 use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::sync::atomic::AtomicI64;
 
 #[derive(Clone, Debug)]
 pub enum CExpr {
@@ -17,6 +19,8 @@ pub enum CExpr {
     /// The type is the result type for min/max, the argument type for to_string.
     Builtin(Builtin, BaseTy, Vec<CExpr>),
     Ext(&'static Functor, Vec<CExpr>),
+    /// `autoinc()`: takes the next number of the engine's counter.
+    Autoinc(Arc<AtomicI64>),
 }
 
 impl std::fmt::Debug for Functor {
@@ -104,6 +108,8 @@ pub struct CRule {
 struct Slots {
     names: Vec<String>,
     map: BTreeMap<String, u32>,
+    /// The engine's `autoinc()` counter.
+    counter: Arc<AtomicI64>,
 }
 
 impl Slots {
@@ -123,17 +129,22 @@ pub fn compile_rule(
     id: usize,
     rels: &mut [Relation],
     in_stratum: &[bool],
+    counter: &Arc<AtomicI64>,
 ) -> CRule {
     let rule = &prog.rules[id];
     let mut slots = Slots {
         names: Vec::new(),
         map: BTreeMap::new(),
+        counter: counter.clone(),
     };
     let steps = compile_steps(prog, &rule.body, &rule.plan, &mut slots, rels, Vec::new());
 
     let head: Vec<CExpr> = rule.head.args.iter().map(|e| expr(e, &mut slots)).collect();
     let mut steps = steps;
-    set_projections(&mut steps, &head, rels);
+    // `autoinc()` is evaluated once per body match: only atoms that bind nothing read later
+    // are reduced to their first tuple (Soufflé's existence checks).
+    let counts_matches = head.iter().any(has_autoinc) || steps.iter().any(step_has_autoinc);
+    set_projections(&mut steps, &head, rels, counts_matches);
     let head_rel = prog.rel_index[&rule.head.rel];
     let rec: Vec<usize> = steps
         .iter()
@@ -357,6 +368,7 @@ fn expr(e: &Expr, slots: &mut Slots) -> CExpr {
         ExprKind::Bin(op, a, b) => {
             CExpr::Bin(*op, ty, Box::new(expr(a, slots)), Box::new(expr(b, slots)))
         }
+        ExprKind::Builtin(Builtin::Autoinc, _) => CExpr::Autoinc(slots.counter.clone()),
         ExprKind::Builtin(b, args) => {
             let t = if *b == Builtin::ToString {
                 args[0].ty.unwrap_or(BaseTy::Number)
@@ -374,7 +386,7 @@ fn expr(e: &Expr, slots: &mut Slots) -> CExpr {
 }
 
 /// Mark scans whose bound columns are partly unused afterwards (see `CStep::Scan::project`).
-fn set_projections(steps: &mut [CStep], head: &[CExpr], rels: &[Relation]) {
+fn set_projections(steps: &mut [CStep], head: &[CExpr], rels: &[Relation], counts_matches: bool) {
     for i in 0..steps.len() {
         let mut used = Vec::new();
         for s in &steps[i + 1..] {
@@ -396,7 +408,7 @@ fn set_projections(steps: &mut [CStep], head: &[CExpr], rels: &[Relation]) {
                 .filter(|(_, s)| used.contains(s))
                 .map(|(c, _)| *c)
                 .collect();
-            if wild > 0 || live.len() < binds.len() {
+            if (wild > 0 || live.len() < binds.len()) && !(counts_matches && !live.is_empty()) {
                 *project = Some(live);
             }
         }
@@ -433,7 +445,7 @@ fn agg_reads(g: &CAgg, out: &mut Vec<u32>) {
 fn expr_reads(e: &CExpr, out: &mut Vec<u32>) {
     match e {
         CExpr::Slot(s) => out.push(*s),
-        CExpr::Const(_) => {}
+        CExpr::Const(_) | CExpr::Autoinc(_) => {}
         CExpr::Neg(_, x) => expr_reads(x, out),
         CExpr::Bin(_, _, a, b) => {
             expr_reads(a, out);
@@ -443,4 +455,31 @@ fn expr_reads(e: &CExpr, out: &mut Vec<u32>) {
             args.iter().for_each(|a| expr_reads(a, out))
         }
     }
+}
+
+fn has_autoinc(e: &CExpr) -> bool {
+    match e {
+        CExpr::Autoinc(_) => true,
+        CExpr::Slot(_) | CExpr::Const(_) => false,
+        CExpr::Neg(_, x) => has_autoinc(x),
+        CExpr::Bin(_, _, a, b) => has_autoinc(a) || has_autoinc(b),
+        CExpr::Builtin(_, _, args) | CExpr::Ext(_, args) => args.iter().any(has_autoinc),
+    }
+}
+
+fn step_has_autoinc(s: &CStep) -> bool {
+    match s {
+        CStep::Scan { key, checks, .. } => {
+            key.iter().any(has_autoinc) || checks.iter().any(|(_, e)| has_autoinc(e))
+        }
+        CStep::Negate { key, .. } => key.iter().any(has_autoinc),
+        CStep::Filter(_, _, a, b) | CStep::StrTest { a, b, .. } => has_autoinc(a) || has_autoinc(b),
+        CStep::Assign(_, e) => has_autoinc(e),
+        CStep::AggAssign(_, g) => agg_has_autoinc(g),
+        CStep::AggFilter { other, agg, .. } => has_autoinc(other) || agg_has_autoinc(agg),
+    }
+}
+
+fn agg_has_autoinc(g: &CAgg) -> bool {
+    g.steps.iter().any(step_has_autoinc) || g.target.as_ref().is_some_and(has_autoinc)
 }

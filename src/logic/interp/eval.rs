@@ -5,6 +5,7 @@ use crate::logic::error::EvalError;
 use crate::logic::front::ast::{BinOp, Builtin, CmpOp};
 use crate::logic::ops;
 use crate::logic::value::{BaseTy, F64, Value};
+use std::sync::atomic::Ordering;
 
 pub fn eval(e: &CExpr, env: &[Value]) -> Result<Value, EvalError> {
     Ok(match e {
@@ -31,6 +32,7 @@ pub fn eval(e: &CExpr, env: &[Value]) -> Result<Value, EvalError> {
                 .collect::<Result<_, _>>()?;
             (f.call)(&vals)
         }
+        CExpr::Autoinc(counter) => Value::Number(counter.fetch_add(1, Ordering::Relaxed)),
     })
 }
 
@@ -138,6 +140,7 @@ fn builtin(b: Builtin, ty: BaseTy, v: Vec<Value>) -> Result<Value, EvalError> {
         },
         Builtin::Ftoi => Value::Number(v[0].as_float().unwrap_or(0.0) as i64),
         Builtin::Ftou => Value::Unsigned(v[0].as_float().unwrap_or(0.0) as u64),
+        Builtin::Autoinc => return Err(EvalError("autoinc() outside a rule".into())),
     })
 }
 

@@ -120,6 +120,8 @@ impl Engine {
             .map(|r| Relation::new(r.arity()))
             .collect();
         let mut strata = Vec::new();
+        // One `autoinc()` counter per engine, as Soufflé has one per program run.
+        let autoinc = std::sync::Arc::new(std::sync::atomic::AtomicI64::new(0));
         for s in &program.strata {
             let mut in_stratum = vec![false; rels.len()];
             for &r in &s.relations {
@@ -128,7 +130,9 @@ impl Engine {
             strata.push(
                 s.rules
                     .iter()
-                    .map(|&id| compile::compile_rule(&program, id, &mut rels, &in_stratum))
+                    .map(|&id| {
+                        compile::compile_rule(&program, id, &mut rels, &in_stratum, &autoinc)
+                    })
                     .collect(),
             );
         }

@@ -12,6 +12,8 @@ pub(super) struct Checker<'f> {
     /// User type name → (parent name, is_subtype, span).
     pub(super) types: BTreeMap<String, TypeDecl>,
     pub(super) agg_counter: usize,
+    /// Renamings made by inlining (`__inlN_x`).
+    pub(super) inline_counter: usize,
     /// Fresh variables standing for expression arguments of body atoms (`__argN`).
     pub(super) arg_counter: usize,
     /// Relation name → attribute base types.

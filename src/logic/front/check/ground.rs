@@ -125,7 +125,7 @@ impl Checker<'_> {
                 if let Some(v) = witness {
                     self.error(
                         lit.span(),
-                        format!("variable `{v}` is grounded only inside the aggregate but used outside it (the witness problem: an aggregate cannot export a binding)"),
+                        format!("variable `{v}` is grounded only inside the aggregate but used outside it (the witness problem: only a top-level min or max aggregate exports a witness, not count, sum, mean or a nested aggregate)"),
                         format!("bind `{v}` in a positive atom outside the aggregate, or use a fresh variable inside it"),
                     );
                     return None;

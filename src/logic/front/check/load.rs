@@ -177,6 +177,7 @@ impl<'f> Loader<'f> {
             errors: Vec::new(),
             types: BTreeMap::new(),
             agg_counter: 0,
+            inline_counter: 0,
             arg_counter: 0,
             atom_types: BTreeMap::new(),
         }

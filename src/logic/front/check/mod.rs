@@ -4,12 +4,14 @@
 mod checker;
 mod desugar;
 mod ground;
+mod inline;
 mod load;
 mod pipeline;
 mod program;
 mod strata;
 mod types;
 mod walk;
+mod witness;
 
 pub use load::Loader;
 pub use program::{FunctorSig, Program, Stratum};

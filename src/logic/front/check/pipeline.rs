@@ -6,8 +6,10 @@ use super::super::diag::{Diagnostics, closest};
 use super::super::parse::Item;
 use super::checker::{Checker, Env};
 use super::desugar::eqrel_rules;
+use super::inline::InlineDefs;
 use super::program::Program;
-use super::walk::{expr_vars, lit_exprs_mut};
+use super::program::Stratum;
+use super::walk::{collect_deps, expr_vars, lit_exprs_mut, rule_has_autoinc};
 use std::collections::{BTreeMap, BTreeSet};
 
 impl Checker<'_> {
@@ -188,11 +190,23 @@ impl Checker<'_> {
                 _ => None,
             })
             .collect();
+        let inline: BTreeMap<String, Span> = items
+            .iter()
+            .filter_map(|(_, item)| match item {
+                Item::Decl {
+                    name,
+                    inline: true,
+                    span,
+                    ..
+                } if rel_index.contains_key(name) => Some((name.clone(), *span)),
+                _ => None,
+            })
+            .collect();
         // Clauses.
-        let mut rules = Vec::new();
+        let mut clauses = Vec::new();
         let mut labels: BTreeMap<String, Span> = BTreeMap::new();
         for (_, item) in items {
-            if let Item::Clause(mut rule) = item {
+            if let Item::Clause(rule) = item {
                 if let Some(l) = &rule.label {
                     if let Some(prev) = labels.get(l) {
                         if prev.line != rule.span.line || prev.file != rule.span.file {
@@ -206,8 +220,52 @@ impl Checker<'_> {
                     }
                     labels.insert(l.clone(), rule.span);
                 }
-                if self.check_rule(&mut rule, &relations, &rel_index) {
-                    rules.push(rule);
+                if rule.body.is_empty() && rule_has_autoinc(&rule) {
+                    self.error(
+                        rule.span,
+                        "argument in fact is not constant: `autoinc()` in a fact",
+                        "a fact's arguments are constants; derive the tuple with a rule instead",
+                    );
+                    continue;
+                }
+                clauses.push(rule);
+            }
+        }
+        let mut rules = Vec::new();
+        for rule in &clauses {
+            let mut rule = rule.clone();
+            if self.check_rule(&mut rule, &relations, &rel_index) {
+                rules.push(rule);
+            }
+        }
+        if !inline.is_empty() && self.errors.is_empty() {
+            // Checked as written first (errors point at what was written), then inlined.
+            let defs: InlineDefs = inline
+                .iter()
+                .map(|(name, span)| {
+                    let defining = clauses.iter().filter(|r| &r.head.rel == name);
+                    (name.clone(), (*span, defining.cloned().collect()))
+                })
+                .collect();
+            self.check_inlining(&defs, &relations, &clauses, &items_eqrel);
+            if !self.errors.is_empty() {
+                return Err(Diagnostics(self.errors));
+            }
+            relations.retain(|r| !defs.contains_key(&r.name));
+            rel_index = relations
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (r.name.clone(), i))
+                .collect();
+            rules.clear();
+            for rule in clauses
+                .into_iter()
+                .filter(|r| !defs.contains_key(&r.head.rel))
+            {
+                for mut rule in self.inline_uses(rule, &defs).unwrap_or_default() {
+                    if self.check_rule(&mut rule, &relations, &rel_index) {
+                        rules.push(rule);
+                    }
                 }
             }
         }
@@ -232,6 +290,7 @@ impl Checker<'_> {
             return Err(Diagnostics(self.errors));
         }
         let strata = self.stratify(&relations, &rel_index, &rules);
+        self.check_autoinc_recursion(&strata, &rules, &rel_index);
         if !self.errors.is_empty() {
             return Err(Diagnostics(self.errors));
         }
@@ -243,6 +302,32 @@ impl Checker<'_> {
             rules,
             strata,
         })
+    }
+
+    /// Soufflé refuses `autoinc()` in a rule that reads its own stratum (a recursive rule).
+    fn check_autoinc_recursion(
+        &mut self,
+        strata: &[Stratum],
+        rules: &[Rule],
+        rel_index: &BTreeMap<String, usize>,
+    ) {
+        for s in strata.iter().filter(|s| s.recursive) {
+            for &ri in &s.rules {
+                let rule = &rules[ri];
+                if !rule_has_autoinc(rule) {
+                    continue;
+                }
+                let mut deps = Vec::new();
+                collect_deps(&rule.body, false, rel_index, &mut deps);
+                if deps.iter().any(|(b, _, _)| s.relations.contains(b)) {
+                    self.error(
+                        rule.span,
+                        "auto-increment functor `autoinc()` in a recursive rule",
+                        "Soufflé refuses it (each iteration would count anew): compute the numbers in a non-recursive rule",
+                    );
+                }
+            }
+        }
     }
 
     /// Returns false (after recording errors) if the rule is unusable.
@@ -275,6 +360,7 @@ impl Checker<'_> {
         // matched after the atom binds it: a fresh variable in its place, equal to it.
         self.lift_self_bound_args(&mut body, false);
         rule.body = body;
+        self.ground_witnesses(rule);
         // Relations and arities.
         self.check_atom(&rule.head, rels, idx);
         self.check_atoms_in(&rule.body, rels, idx);

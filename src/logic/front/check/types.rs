@@ -598,6 +598,7 @@ pub fn builtin_sig(b: Builtin) -> Option<(&'static [Option<BaseTy>], BaseTy)> {
         Builtin::Utof => (&[Some(Unsigned)], Float),
         Builtin::Ftoi => (&[Some(Float)], Number),
         Builtin::Ftou => (&[Some(Float)], Unsigned),
+        Builtin::Autoinc => (&[], Number),
     })
 }
 

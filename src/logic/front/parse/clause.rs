@@ -236,7 +236,7 @@ impl<'a> Parser<'a> {
                     }]]);
                 }
                 if Builtin::from_name(&name).is_none()
-                    && !["autoinc", "range", "as"].contains(&name.as_str())
+                    && !["range", "as"].contains(&name.as_str())
                     && !is_agg_name(&name)
                 {
                     return Ok(vec![vec![Literal::Pos(self.atom()?)]]);

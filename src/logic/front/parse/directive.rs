@@ -112,13 +112,17 @@ impl<'a> Parser<'a> {
                 // Qualifiers: storage hints are accepted and ignored; the ones that
                 // change meaning are refused by name.
                 let mut eqrel = false;
+                let mut inline = false;
                 loop {
                     match self.peek().clone() {
+                        Tok::Ident(q) if q == "inline" => {
+                            inline = true;
+                            self.bump();
+                        }
                         Tok::Ident(q)
                             if [
                                 "btree",
                                 "brie",
-                                "inline",
                                 "no_inline",
                                 "magic",
                                 "no_magic",
@@ -166,6 +170,7 @@ impl<'a> Parser<'a> {
                         name,
                         attrs: attrs.clone(),
                         eqrel,
+                        inline,
                         span: nspan,
                     });
                 }

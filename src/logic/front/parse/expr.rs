@@ -186,7 +186,7 @@ impl<'a> Parser<'a> {
                         "records are an unsupported Soufflé feature",
                     );
                 }
-                if ["autoinc", "range", "as"].contains(&name.as_str())
+                if ["range", "as"].contains(&name.as_str())
                     && matches!(self.peek_at(1), Tok::P("("))
                 {
                     return err(

@@ -36,6 +36,8 @@ pub enum Item {
         attrs: Vec<(String, String, Span)>,
         /// Declared `eqrel`: the relation is an equivalence relation.
         eqrel: bool,
+        /// Declared `inline`: its rules are substituted into every use.
+        inline: bool,
         span: Span,
     },
     Io {
