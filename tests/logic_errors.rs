@@ -380,3 +380,20 @@ fn autoinc_is_refused_where_soufflé_refuses_it() {
         "takes 0 argument(s)",
     );
 }
+
+// Counting to 10^6 one step at a time takes 10^6 iterations of one stratum: a long program,
+// not a runaway one, so the default limits (no iteration bound, as in Soufflé) let it finish
+// with n = 0, 1, ..., 1000000: 1,000,001 rows.
+#[test]
+fn a_long_count_runs_to_its_end_under_the_default_limits() {
+    let p = Arc::new(
+        Program::parse_str(
+            "count.dl",
+            ".decl n(x: number)\nn(0).\nn(x + 1) :- n(x), x < 1000000.\n",
+        )
+        .unwrap(),
+    );
+    let mut e = Engine::new(p, Options::default());
+    e.run().unwrap();
+    assert_eq!(e.len("n").unwrap(), 1_000_001);
+}

@@ -89,6 +89,34 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+    // An expression in the head or in a negated atom is the same expression moved into an
+    // equality constraint: `r(E4, Y) :- p(X, Y), !q(E5, X).` gives, by enumeration, (E4, y)
+    // for each (x, y) in p with no (E5, x) in q; so do its rewrites.
+    #[test]
+    fn expressions_in_heads_and_negations_are_equality_constraints(
+        e4 in linear(), e5 in linear(), p in facts(), q in facts(),
+    ) {
+        let q_set: BTreeSet<(i64, i64)> = q.iter().copied().collect();
+        let want: BTreeSet<Vec<i64>> = p
+            .iter()
+            .filter(|&&(x, y)| !q_set.contains(&(e5.at(x, y), x)))
+            .map(|&(x, y)| vec![e4.at(x, y), y])
+            .collect();
+        let (t4, t5) = (e4.text("X", "Y"), e5.text("X", "Y"));
+        for rule in [
+            format!("r({t4}, Y) :- p(X, Y), !q({t5}, X)."),
+            format!("r(H, Y) :- p(X, Y), H = {t4}, !q({t5}, X)."),
+            format!("r({t4}, Y) :- p(X, Y), W = {t5}, !q(W, X)."),
+            format!("r(H, Y) :- W = {t5}, !q(W, X), H = {t4}, p(X, Y)."),
+        ] {
+            let text = format!("{DECLS}{rule}\n");
+            prop_assert_eq!(&run(&text, &p, &q, "r"), &want, "{}", text);
+        }
+    }
+}
+
 /// IEEE equality in a comparison: 0.0 = -0.0, whichever side binds the variable.
 #[test]
 fn a_float_comparison_with_negative_zero_holds_for_zero() {

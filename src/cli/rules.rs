@@ -25,9 +25,10 @@ pub enum RulesCommand {
         /// Stop when the relations hold more tuples than this.
         #[arg(long, default_value_t = Limits::default().max_tuples)]
         max_tuples: usize,
-        /// Stop when a recursive stratum needs more iterations than this.
-        #[arg(long, default_value_t = Limits::default().max_iterations)]
-        max_iterations: usize,
+        /// Stop when a recursive stratum needs more iterations than this (default: no bound, as
+        /// in Soufflé; a program that never stops is caught by --max-tuples).
+        #[arg(long)]
+        max_iterations: Option<usize>,
         /// Stop when the joins of the run have visited more body tuples than this.
         #[arg(long, default_value_t = Limits::default().max_steps)]
         max_steps: u64,
@@ -88,7 +89,7 @@ pub fn run(cmd: RulesCommand) -> CmdResult {
                 provenance: !queries.is_empty(),
                 limits: Limits {
                     max_tuples,
-                    max_iterations,
+                    max_iterations: max_iterations.unwrap_or(Limits::default().max_iterations),
                     max_steps,
                 },
             };

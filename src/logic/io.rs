@@ -1,7 +1,8 @@
 //! Soufflé-compatible file I/O: `.input` reads `<rel>.facts` (tab-separated,
 //! symbols unquoted) from the facts directory, `.output` writes `<rel>.csv`
 //! (tab-separated, sorted) into the output directory; `filename=` and
-//! `delimiter=` override the defaults. A file name must stay inside its folder:
+//! `delimiter=` override the defaults. Symbols are written as they are, as Soufflé's
+//! writer does: one holding a line break or the delimiter spans lines or fields. A file name must stay inside its folder:
 //! no absolute path, no `..`, no symbolic link leading out (a rule file passed
 //! around must not read or write elsewhere).
 
@@ -9,7 +10,6 @@ use super::error::LogicError;
 use super::front::ast::IoSpec;
 use super::front::confine;
 use super::interp::{Engine, Origin};
-use super::io_symbols::unwritable_symbol;
 use super::value::Value;
 use std::path::{Path, PathBuf};
 
@@ -176,14 +176,6 @@ pub fn write_outputs(
             source,
         })?;
         let path = file_for(engine, out_dir, &r.name, spec, Direction::Output)?;
-        if let Some((symbol, why)) = unwritable_symbol(&tuples, &spec.delimiter) {
-            return Err(LogicError::Usage(format!(
-                "cannot write `{}` to {}: the symbol {symbol:?} {why}, and .facts/.csv files \
-                 hold symbols unquoted; change the rules that derive it (or the delimiter)",
-                r.name,
-                path.display()
-            )));
-        }
         if let Some(parent) = path.parent() {
             std::fs::create_dir_all(parent).map_err(|source| LogicError::Write {
                 path: parent.to_path_buf(),

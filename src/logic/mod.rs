@@ -5,7 +5,8 @@
 //!   compiled into `build.rs`).
 //! - `interp`: the semi-naive interpreter with provenance (`Engine`).
 //! - `compiled`: ascent programs generated from `rules/*.dl` and `tests/logic/*.dl`.
-//! - `functors`: the Rust functors `@name(...)`; `ops`: typed operations both engines share.
+//! - `functors`: the Rust functors `@name(...)`; `ops`: typed operations both engines share;
+//!   `std_regex`: `match` patterns read as Soufflé's C++ std::regex reads them.
 
 pub mod compiled;
 pub mod error;
@@ -13,9 +14,9 @@ pub mod front;
 pub mod functors;
 pub mod interp;
 pub mod io;
-pub mod io_symbols;
 pub mod ops;
 pub mod provenance;
+pub mod std_regex;
 pub mod tokens;
 pub mod value;
 

@@ -3,6 +3,7 @@
 //! `Err` carries the message of a runtime error (the caller names the rule).
 
 use super::error::EvalError;
+use super::std_regex::{PatternError, StdRegex};
 use super::value::{F64, Sym, format_float};
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -175,33 +176,32 @@ pub fn take_warnings() -> Vec<String> {
     WARNINGS.with(|w| std::mem::take(&mut *w.borrow_mut()).into_iter().collect())
 }
 
-/// Whole-string regular-expression match (like `std::regex_match`). A
-/// pattern that is not a valid regular expression matches nothing and leaves
-/// a warning, as Soufflé documents ("wrong pattern provided for match").
-pub fn regex_match(pattern: &str, text: &str) -> OpResult<bool> {
+/// `match(pattern, text)`, or `!match(pattern, text)` when `negated`, as Soufflé evaluates
+/// them (`std::regex_match`, see `std_regex`). A pattern that is not a regular expression
+/// makes both false, as in Soufflé, and leaves a warning ("wrong pattern provided for match").
+pub fn match_test(pattern: &str, text: &str, negated: bool) -> bool {
     thread_local! {
-        /// Compiled patterns, or why one is not a regular expression. Only a cache: the
-        /// warning is recorded on every use, so a run warns whatever ran before it.
-        static CACHE: RefCell<HashMap<String, Result<regex::Regex, regex::Error>>> = RefCell::new(HashMap::new());
+        /// Compiled patterns, or why one is refused. Only a cache: the warning is recorded
+        /// on every use, so a run warns whatever ran before it.
+        static CACHE: RefCell<HashMap<String, Result<StdRegex, PatternError>>> = RefCell::new(HashMap::new());
     }
     CACHE.with(|c| {
         let mut c = c.borrow_mut();
         if !c.contains_key(pattern) {
-            let re = regex::Regex::new(&format!("^(?:{pattern})$"));
             if c.len() > 1024 {
                 c.clear();
             }
-            c.insert(pattern.to_string(), re);
+            c.insert(pattern.to_string(), StdRegex::new(pattern));
         }
         match &c[pattern] {
-            Ok(re) => Ok(re.is_match(text)),
+            Ok(re) => re.is_full_match(text) != negated,
             Err(e) => {
-                let first = e.to_string().lines().last().unwrap_or_default().to_string();
+                let not = if negated { "!" } else { "" };
                 let warning = format!(
-                    "wrong pattern provided for match({pattern:?}, ...): {first}; it matches nothing"
+                    "wrong pattern provided for {not}match({pattern:?}, ...): {e}; it holds for no text"
                 );
                 WARNINGS.with(|w| w.borrow_mut().insert(warning));
-                Ok(false)
+                false
             }
         }
     })
@@ -238,10 +238,12 @@ mod tests {
         assert_eq!(&*substr("hello", 1, 3).unwrap(), "ell");
         assert_eq!(&*substr("hello", 3, 10).unwrap(), "lo");
         assert!(substr("hello", 6, 1).is_err());
-        assert!(regex_match("a.*c", "abc").unwrap());
-        assert!(!regex_match("b", "abc").unwrap());
-        assert!(!regex_match("(", "x").unwrap());
-        assert_eq!(take_warnings().len(), 1);
+        assert!(match_test("a.*c", "abc", false));
+        assert!(!match_test("b", "abc", false));
+        assert!(match_test("b", "abc", true));
+        assert!(!match_test("(", "x", false));
+        assert!(!match_test("(", "x", true));
+        assert_eq!(take_warnings().len(), 2);
         assert_eq!(to_number(" 42 ").unwrap(), 42);
         assert!(to_number("4x").is_err());
     }

@@ -67,8 +67,9 @@ pub fn to_unsigned(s: &str, rule: &str) -> u64 {
 pub fn to_float(s: &str, rule: &str) -> F64 {
     or_fail(ops::to_float(s), rule, F64(0.0))
 }
-pub fn regex_match(pattern: &str, text: &str, rule: &str) -> bool {
-    or_fail(ops::regex_match(pattern, text), rule, false)
+/// `match` (`!match` when `negated`); see `ops::match_test`.
+pub fn match_test(pattern: &str, text: &str, negated: bool) -> bool {
+    ops::match_test(pattern, text, negated)
 }
 /// `min(a, b)` on floats as the interpreter computes it (IEEE `<`).
 pub fn min2_f64(acc: F64, x: F64) -> F64 {

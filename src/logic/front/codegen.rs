@@ -279,13 +279,14 @@ impl Gen<'_> {
                         ..
                     } => {
                         let (x, y) = (self.expr(&args[0], b)?, self.expr(&args[1], b)?);
-                        let call = if *is_match {
-                            format!("rt::regex_match(&{x}, &{y}, {:?})", b.rule_name)
+                        // An invalid pattern makes `match` and `!match` both false.
+                        let test = if *is_match {
+                            format!("rt::match_test(&{x}, &{y}, {negated})")
                         } else {
-                            format!("crate::logic::ops::contains(&{x}, &{y})")
+                            let not = if *negated { "!" } else { "" };
+                            format!("{not}crate::logic::ops::contains(&{x}, &{y})")
                         };
-                        b.clauses
-                            .push(format!("if {}{call}", if *negated { "!" } else { "" }));
+                        b.clauses.push(format!("if {test}"));
                     }
                     _ => unreachable!(),
                 },

@@ -186,12 +186,13 @@ impl<'a> Exec<'a> {
             } => {
                 let (x, y) = (eval::eval(a, env)?, eval::eval(b, env)?);
                 let (x, y) = (x.as_symbol().unwrap_or(""), y.as_symbol().unwrap_or(""));
+                // An invalid pattern makes `match` and `!match` both false.
                 let holds = if *is_match {
-                    ops::regex_match(x, y)?
+                    ops::match_test(x, y, *negated)
                 } else {
-                    ops::contains(x, y)
+                    ops::contains(x, y) != *negated
                 };
-                if holds != *negated {
+                if holds {
                     self.run(rest, env, k)
                 } else {
                     Ok(())

@@ -59,12 +59,14 @@ pub enum Prov {
     },
 }
 
-/// Bounds that stop runaway programs (e.g. `n(x+1) :- n(x).`).
+/// Bounds that stop runaway programs (e.g. `n(x+1) :- n(x).`), not long ones: a program that
+/// never stops keeps adding tuples, so the tuple bound catches it; a long program that
+/// terminates runs as in Soufflé, which has no bound on iterations.
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
-    /// Total tuples over all relations.
+    /// Total tuples over all relations (memory).
     pub max_tuples: usize,
-    /// Semi-naive iterations per stratum.
+    /// Semi-naive iterations per stratum; `usize::MAX` (the default) is no bound.
     pub max_iterations: usize,
     /// Body tuples visited over the whole run: the work of joins, which can be huge for
     /// few derived tuples (`r(1) :- a(x), a(y), a(z).`).
@@ -75,7 +77,8 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             max_tuples: 50_000_000,
-            max_iterations: 100_000,
+            // None: counting to 10^6 one step at a time is an ordinary program.
+            max_iterations: usize::MAX,
             // About 3 minutes of joining on one core (10^7 visits/s measured); far above
             // any rule set framewright ships.
             max_steps: 2_000_000_000,
