@@ -5,7 +5,9 @@
 //! linear to within 0.1 mm and 0.2 mrad).
 //!
 //! The document is built with `gltf-json`; the cell is Z-up, glTF Y-up: one root node turns
-//! the one into the other. Node names: `link <name>`, `tool`, `piece <id>`, `floor`, …
+//! the one into the other. Node names: `link <name>`, `tool`, `piece <id>`, `floor`, … A
+//! piece's node rests at its framing target (the report's viewer draws it there, faint, while
+//! it is not in the world).
 
 use super::simulate::SimReport;
 use super::verdict;
@@ -101,7 +103,7 @@ pub fn scene_wall_glb(
             .filter(|t| t.keys.first().is_some_and(|k| k.0 <= end))
         {
             Some(track) => {
-                let node = g.piece_node(id, &piece.size, m, None, true);
+                let node = g.piece_node(id, &piece.size, m, Some(&piece.target_cell), true);
                 animation.lumber(&mut g, node, track, end);
                 top.push(node);
             }
@@ -618,7 +620,8 @@ impl Builder {
         cell: &Cell,
         fk: &[Isometry3<f64>],
     ) -> Vec<(usize, json::Index<json::Node>)> {
-        let robot_m = self.material("robot", [0.9, 0.35, 0.02]);
+        // Blue: apart from every verdict's colour (green, amber, red, grey).
+        let robot_m = self.material("robot", [0.06, 0.2, 0.55]);
         let tool_m = self.material("tool", [0.25, 0.25, 0.27]);
         let robot = &cell.robot;
         let mut out = Vec::new();

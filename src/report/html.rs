@@ -1,17 +1,19 @@
 //! The report a person reads: `simulate --report DIR` writes `index.html` (one self-contained
-//! page: inline CSS and SVG, no script, no network, no dates), `scene.glb` (or one
-//! `scene-NNN.glb` per wall when there are several) and `simulate.json`. With more than
-//! [`WALLS_PER_PAGE`] walls the index keeps the table and the root causes and each wall gets
-//! its own page `wall-NNN.html`.
+//! page: inline CSS, SVG and script, no network, no dates), `scene.glb` (or one
+//! `scene-NNN.glb` per wall when there are several) and `simulate.json`. Each wall's section
+//! shows its scene in a 3D view ([`super::viewer`]: the scene embedded in the page, drawn by
+//! the viewer's script). With more than [`WALLS_PER_PAGE`] walls the index keeps the table
+//! and the root causes and each wall gets its own page `wall-NNN.html`, with its view.
 //!
 //! Every name and id from the model goes through maud, which escapes text and attribute
-//! values by default.
+//! values by default; none is written into a script.
 
 use super::glb;
 use super::markup_text::replace_forbidden;
 use super::simulate::SimReport;
 use super::svg;
 use super::verdict;
+use super::viewer;
 use super::wall_view::WallView;
 use crate::cell::Cell;
 use crate::ifc::Model;
@@ -36,7 +38,8 @@ pub struct ReportInput<'a> {
 /// The environment variable with which the CLI bounds a report's size in bytes (all its files are built in
 /// memory before the folder is swapped in, so this bounds the memory the report takes too).
 pub const ENV_MAX_REPORT_BYTES: &str = "FRAMEWRIGHT_MAX_REPORT_BYTES";
-/// The default bound: 2 GiB (a 150-wall building's report is about 200 MB).
+/// The default bound: 2 GiB (a 150-wall building's report was about 200 MB before the pages
+/// embedded their walls' scenes, which adds about 0.9 times the scenes' size).
 pub const DEFAULT_MAX_REPORT_BYTES: u64 = 2 << 30;
 
 /// The files of a report, by name in the report folder, in writing order.
@@ -84,9 +87,27 @@ pub fn report_files_within(
         }
     };
     let page_name = |i: usize| format!("wall-{:03}.html", i + 1);
+    // The walls' scenes are independent: built (and embedded for the pages) in parallel, kept
+    // in wall order.
+    let (cell, scene, records, report) = (
+        input.cell,
+        &input.sim.scene,
+        input.sim.records.as_slice(),
+        input.report,
+    );
+    let wall_ids: Vec<&str> = walls.iter().map(|w| w.record.wall.as_str()).collect();
+    let (scenes, mut embedded): (Vec<Option<Vec<u8>>>, Vec<Option<String>>) = wall_ids
+        .par_iter()
+        .map(|wall| {
+            let glb = glb::scene_wall_glb(cell, scene, records, report, wall);
+            let text = glb.as_deref().map(viewer::embed);
+            (glb, text)
+        })
+        .unzip();
     let index = page(
         input,
         "Simulation report",
+        !split && embedded.iter().any(Option::is_some),
         html! {
             (header(input))
             h2 { "Summary" }
@@ -95,7 +116,7 @@ pub fn report_files_within(
             @if split {
                 @for w in &walls { (causes(w)) }
             } @else {
-                @for (i, w) in walls.iter().enumerate() { (wall_section(input, w, &scene_name(i))) }
+                @for (i, w) in walls.iter().enumerate() { (wall_section(input, w, &scene_name(i), embedded[i].as_deref())) }
             }
             (validation(input.report))
         },
@@ -105,29 +126,21 @@ pub fn report_files_within(
     files.push(("index.html".to_string(), index));
     if split {
         for (i, w) in walls.iter().enumerate() {
+            // Each page embeds its own wall's scene, dropped once the page is built.
+            let view = embedded[i].take();
             let body = html! {
                 p { a href="index.html" { "← all walls" } }
                 (header(input))
-                (wall_section(input, w, &scene_name(i)))
+                (wall_section(input, w, &scene_name(i), view.as_deref()))
             };
             let title = format!("{} — simulation report", w.row.name);
-            let bytes = replace_forbidden(page(input, &title, body).into_string()).into_bytes();
+            let bytes = replace_forbidden(page(input, &title, view.is_some(), body).into_string())
+                .into_bytes();
             check(&page_name(i), &bytes)?;
             files.push((page_name(i), bytes));
         }
     }
-    // The walls' scenes are independent: built in parallel, checked and kept in wall order.
-    let (cell, scene, records, report) = (
-        input.cell,
-        &input.sim.scene,
-        input.sim.records.as_slice(),
-        input.report,
-    );
-    let wall_ids: Vec<&str> = walls.iter().map(|w| w.record.wall.as_str()).collect();
-    let scenes: Vec<Option<Vec<u8>>> = wall_ids
-        .par_iter()
-        .map(|wall| glb::scene_wall_glb(cell, scene, records, report, wall))
-        .collect();
+    drop(embedded);
     for (i, bytes) in scenes.into_iter().enumerate() {
         if let Some(bytes) = bytes {
             check(&scene_name(i), &bytes)?;
@@ -142,7 +155,8 @@ pub fn report_files_within(
     Ok(files)
 }
 
-fn page(input: &ReportInput, title: &str, body: Markup) -> Markup {
+/// A page; with the viewer's script at the end when it shows a wall's 3D view (`views`).
+fn page(input: &ReportInput, title: &str, views: bool, body: Markup) -> Markup {
     html! {
         (DOCTYPE)
         html lang="en" {
@@ -151,7 +165,10 @@ fn page(input: &ReportInput, title: &str, body: Markup) -> Markup {
                 title { (title) " — " (input.model_name) }
                 style { (PreEscaped(super::style::STYLE)) }
             }
-            body { (body) }
+            body {
+                (body)
+                @if views { (viewer::script()) }
+            }
         }
     }
 }
@@ -236,7 +253,8 @@ fn causes(w: &WallView) -> Markup {
     }
 }
 
-fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
+/// A wall's section; with its 3D view when its scene is given (`view`, embedded).
+fn wall_section(input: &ReportInput, w: &WallView, scene: &str, view: Option<&str>) -> Markup {
     let index = input
         .sim
         .records
@@ -265,12 +283,16 @@ fn wall_section(input: &ReportInput, w: &WallView, scene: &str) -> Markup {
             (svg::elevation(w))
             (panels(w))
             (causes(w))
+            h3 { "The run" }
+            @if let Some(v) = view {
+                p { "The cell, the robot (blue) and the lumber coloured by verdict; a piece not in the cell at the time shown is drawn faint at its target. Drag to turn, wheel to zoom, click a piece for its verdict and why; the timeline below follows the view (click it to move there)." }
+                (viewer::view(v, scene))
+            }
+            p { (format!("Framing {:.1} s, nailing {:.1} s.", w.record.framing_time(), w.record.nailing_time())) }
+            (svg::timeline(w))
             h3 { "Cell from above" }
             p { "The wall laid on the assembly area; the dashed circle is the grip's reach straight down at the assembly surface." }
             (svg::plan_view(input.cell, w, thickness))
-            h3 { "Timeline" }
-            p { (format!("Framing {:.1} s, nailing {:.1} s.", w.record.framing_time(), w.record.nailing_time())) }
-            (svg::timeline(w))
             h3 { "Contacts" }
             @if contacts.is_empty() { p { "The robot touched nothing it should not have." } }
             @else {

@@ -21,6 +21,7 @@ mod simulate_text;
 mod style;
 pub mod svg;
 pub mod verdict;
+pub mod viewer;
 pub mod wall_view;
 
 /// Rounds a length to 1e-9 m (and turns -0 into 0).

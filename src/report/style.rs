@@ -14,4 +14,17 @@ svg g.piece:hover rect, svg polygon.piece:hover { stroke-width: 3; }
 rect.op { fill: #90a4ae; } rect.op.feed { fill: #cfd8dc; } rect.op.pick { fill: #42a5f5; }
 rect.op.move { fill: #7e57c2; } rect.op.place { fill: #26a69a; } rect.op.retract { fill: #b0bec5; }
 rect.op.nail { fill: #6d4c41; }
+figure.viewer { margin: 0.5em 0; }
+figure.viewer [hidden] { display: none; }
+.viewer-stage { display: flex; gap: 10px; align-items: flex-start; }
+.viewer-stage canvas { flex: 1 1 auto; min-width: 0; width: 100%; border: 1px solid #ddd; background: #f5f7fa; cursor: grab; touch-action: none; }
+.viewer-info { flex: 0 0 240px; font-size: 13px; }
+.viewer-info .why { border-left: 3px solid #e53935; padding-left: 6px; }
+.viewer-controls { display: flex; gap: 8px; align-items: center; margin: 4px 0; font-size: 13px; }
+.viewer-controls input.time { flex: 1; }
+.viewer-controls output { font-variant-numeric: tabular-nums; min-width: 9em; }
+.causes li.picked { background: #fff59d; }
+svg g.piece.picked rect { stroke: #f9a825; stroke-width: 4; }
+svg g.row.picked text { font-weight: bold; }
+svg.timeline line.now { stroke: #d81b60; stroke-width: 1.5; }
 "#;

@@ -347,7 +347,8 @@ fn stadium(ends: [[f64; 2]; 2], r: f64) -> Vec<[f64; 2]> {
 
 /// The operations of a wall's run on a time axis: a row per element, a bar per operation
 /// (feed = waiting for the piece, pick = approach and grip, move = transfer, place, retract,
-/// nail), failures marked with a cross where the element's work ended.
+/// nail), failures marked with a cross where the element's work ended. `data-left` and
+/// `data-px-per-s` give the time axis (x = left + t × px per s) to the page's 3D view.
 pub(super) fn timeline(view: &WallView) -> Markup {
     const ROW: f64 = 14.0;
     const LEFT: f64 = 150.0;
@@ -366,7 +367,7 @@ pub(super) fn timeline(view: &WallView) -> Markup {
     };
     html! {
         svg xmlns="http://www.w3.org/2000/svg" class="timeline" width=(f1(WIDTH)) height=(f1(height))
-            viewBox=(format!("0 0 {} {}", f1(WIDTH), f1(height))) {
+            viewBox=(format!("0 0 {} {}", f1(WIDTH), f1(height))) data-left=(f1(LEFT)) data-px-per-s=(format!("{s:.6}")) {
             @for t in &ticks {
                 line x1=(f1(x(*t))) y1="0" x2=(f1(x(*t))) y2=(f1(height - 30.0)) stroke="#ddd" {}
                 text x=(f1(x(*t))) y=(f1(height - 16.0)) font-size="10" text-anchor="middle" { (format!("{t:.0} s")) }

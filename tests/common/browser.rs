@@ -1,5 +1,8 @@
 //! A page as a person sees it: Debian's chromium, headless, loads it from `file://` (skipped,
-//! saying so, when chromium is absent).
+//! saying so, when chromium is absent). WebGL runs on SwiftShader, chromium's software
+//! renderer (opted into, so no deprecation warning reaches the console), and the page gets
+//! ten seconds of virtual time to finish its scripts before the DOM is dumped or the
+//! screenshot taken.
 
 use std::path::Path;
 use std::process::Command;
@@ -25,7 +28,9 @@ pub fn browse(browser: &str, page: &Path, screenshot: &Path) -> (String, String)
         cmd.args([
             "--headless",
             "--no-sandbox",
-            "--disable-gpu",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--virtual-time-budget=10000",
             "--disable-quic",
             "--no-first-run",
             "--disable-background-networking",
