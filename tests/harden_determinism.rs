@@ -33,7 +33,9 @@ const PROGRAM: &str = r#"
 .decl w(s: symbol)
 w("pear"). w("apple"). w("fig").
 .decl o(s: symbol, n: number)
-o(s, ord(s)) :- w(s), !match("(", s).
+o(s, ord(s)) :- w(s), !match("[0-9]+", s).
+.decl bad(s: symbol)
+bad(s) :- w(s), match("(", s).
 .decl first(n: number)
 first(n) :- n = min m : { o(_, m) }.
 "#;
@@ -43,7 +45,7 @@ const OTHER: &str = r#"
 .decl v(s: symbol)
 v("zebra"). v("fig"). v("yak").
 .decl k(n: number)
-k(ord(s)) :- v(s), !match("(", s).
+k(ord(s)) :- v(s), !match("[0-9]+", s), !match("(", s).
 "#;
 
 #[test]

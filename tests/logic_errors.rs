@@ -364,6 +364,13 @@ fn a_runaway_concatenation_stops_at_the_symbol_limit() {
 }
 
 #[test]
+fn unknown_string_escapes_are_refused_as_soufflé_refuses_them() {
+    // Soufflé's lexer knows \" \' \\ \a \b \f \n \r \t \v; "Unknown escape sequence \d"
+    // otherwise (a pattern's `\d` is written `\\d`). The error points at the backslash.
+    fails("s(\"a\\d\").\n", 4, 5, "unknown escape sequence `\\d`");
+}
+
+#[test]
 fn autoinc_is_refused_where_soufflé_refuses_it() {
     // Soufflé: "Argument in fact is not constant" and "Auto-increment functor in a recursive rule".
     fails("e(autoinc(), 1).\n", 4, 1, "`autoinc()` in a fact");

@@ -188,30 +188,10 @@ fn hostile_model(dir: &Path) -> PathBuf {
     path
 }
 
-/// Every script element of a page (as written, or the DOM a browser built) is the 3D view's:
-/// a scene (`type="application/octet-stream"`, base64 only) or, once, the viewer's own code.
+/// The page's only scripts are one wall's view: its scene and the viewer's code.
 fn assert_only_the_viewers_scripts(page: &str) {
-    let script = Regex::new(r"(?s)<script([^>]*)>(.*?)</script>").unwrap();
-    let (mut scenes, mut viewers) = (0, 0);
-    for c in script.captures_iter(page) {
-        if &c[1] == r#" type="application/octet-stream" class="viewer-scene""# {
-            assert!(
-                c[2].bytes()
-                    .all(|b| b.is_ascii_alphanumeric() || b"+/=".contains(&b))
-            );
-            scenes += 1;
-        } else {
-            assert!(
-                c[1].is_empty() && c[2] == *framewright::report::viewer::SCRIPT,
-                "markup from the model reached the page as a script: {}",
-                &c[0][..c[0].len().min(200)]
-            );
-            viewers += 1;
-        }
-    }
-    assert_eq!(page.matches("<script").count(), scenes + viewers);
     assert_eq!(
-        (scenes, viewers),
+        common::page_scripts::viewer_scripts(page),
         (1, 1),
         "one wall's view and the viewer's script"
     );

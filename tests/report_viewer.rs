@@ -91,29 +91,10 @@ fn embedded_scenes(page: &str) -> Vec<Vec<u8>> {
         .collect()
 }
 
-/// Every script element of a page is a scene (base64 only) or the viewer's own script, and
-/// the viewer's script is there once when there is a scene.
+/// Every script element of a page is a scene or the viewer's own script, and the viewer's
+/// script is there once when there is a scene.
 fn assert_only_the_viewers_scripts(page: &str) {
-    let script = Regex::new(r"(?s)<script([^>]*)>(.*?)</script>").unwrap();
-    let mut scenes = 0;
-    let mut viewers = 0;
-    for c in script.captures_iter(page) {
-        match &c[1] {
-            r#" type="application/octet-stream" class="viewer-scene""# => {
-                assert!(
-                    c[2].bytes()
-                        .all(|b| b.is_ascii_alphanumeric() || b"+/=".contains(&b))
-                );
-                scenes += 1;
-            }
-            "" => {
-                assert!(c[2] == *SCRIPT, "a script that is not the viewer's");
-                viewers += 1;
-            }
-            other => panic!("a script element {other:?}"),
-        }
-    }
-    assert_eq!(page.matches("<script").count(), scenes + viewers);
+    let (scenes, viewers) = common::page_scripts::viewer_scripts(page);
     assert_eq!(
         viewers,
         usize::from(scenes > 0),

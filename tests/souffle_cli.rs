@@ -38,9 +38,11 @@ fn a_bad_match_pattern_warns_and_the_run_goes_on() {
         std::fs::read_to_string(out.path().join("r.csv")).unwrap(),
         ""
     );
+    // Soufflé's !match is false too on a pattern it cannot read (its interpreter returns the
+    // `false` it started from when std::regex throws).
     assert_eq!(
         std::fs::read_to_string(out.path().join("nr.csv")).unwrap(),
-        "a\nb\n"
+        ""
     );
 }
 

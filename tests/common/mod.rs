@@ -7,6 +7,7 @@ pub mod arm;
 pub mod bcf;
 pub mod browser;
 pub mod ifc_edit;
+pub mod page_scripts;
 pub mod python;
 pub mod skip;
 

@@ -161,12 +161,24 @@ pub fn lex(file: u32, text: &str) -> Result<(Vec<Token>, Vec<Label>), LexError> 
                     }
                     Some('"') => break,
                     Some('\\') => {
+                        // Soufflé's lexer: these escapes, any other is an error.
                         let e = chars.get(j + 1).copied().unwrap_or(' ');
                         s.push(match e {
+                            '"' | '\'' | '\\' => e,
+                            'a' => '\u{7}',
+                            'b' => '\u{8}',
+                            'f' => '\u{c}',
                             'n' => '\n',
-                            't' => '\t',
                             'r' => '\r',
-                            other => other,
+                            't' => '\t',
+                            'v' => '\u{b}',
+                            other => {
+                                return Err(LexError {
+                                    span: span(line, col + (j - i) as u32, 2),
+                                    message: format!("unknown escape sequence `\\{other}` in a string"),
+                                    hint: "strings know the escapes \\\" \\' \\\\ \\a \\b \\f \\n \\r \\t \\v (as Soufflé); write a backslash as `\\\\`".into(),
+                                });
+                            }
                         });
                         j += 2;
                     }

@@ -408,7 +408,7 @@ fn set_projections(steps: &mut [CStep], head: &[CExpr], rels: &[Relation], count
                 .filter(|(_, s)| used.contains(s))
                 .map(|(c, _)| *c)
                 .collect();
-            if (wild > 0 || live.len() < binds.len()) && !(counts_matches && !live.is_empty()) {
+            if (wild > 0 || live.len() < binds.len()) && (!counts_matches || live.is_empty()) {
                 *project = Some(live);
             }
         }
