@@ -6,20 +6,8 @@ mod common;
 
 use serde_json::Value;
 use std::path::Path;
-use std::process::Command;
 
-fn framewright(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
+use common::framewright_ok as framewright;
 
 /// `why MODEL ID --offset-x X --no-cache`, with `extra` arguments.
 fn why(model: &Path, id: &str, offset_x: &str, extra: &[&str]) -> String {

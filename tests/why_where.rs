@@ -7,20 +7,8 @@ mod common;
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn framewright(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_framewright"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
+use common::framewright_ok as framewright;
 
 fn tm3() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc")
@@ -152,23 +140,16 @@ fn where_survives_the_cache() {
     let dir = tempfile::tempdir().unwrap();
     let model = tm3_stud_moved(dir.path(), 0.020);
     let cache = dir.path().join("cache");
-    let args = |extra: &[&str]| {
-        let mut a = vec![
-            "why".to_string(),
-            model.to_str().unwrap().to_string(),
-            "2nv91WmrtNJ_0CsN4f5WS5".to_string(),
-            "--offset-x".to_string(),
-            "0.742".to_string(),
-            "--cache-dir".to_string(),
-            cache.to_str().unwrap().to_string(),
-        ];
-        a.extend(extra.iter().map(|s| s.to_string()));
-        a
-    };
-    let run = |extra: &[&str]| {
-        let a = args(extra);
-        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
-        framewright(&refs)
+    let run = || {
+        framewright(&[
+            "why",
+            model.to_str().unwrap(),
+            "2nv91WmrtNJ_0CsN4f5WS5",
+            "--offset-x",
+            "0.742",
+            "--cache-dir",
+            cache.to_str().unwrap(),
+        ])
     };
     let wheres = |text: &str| -> Vec<String> {
         text.lines()
@@ -176,8 +157,8 @@ fn where_survives_the_cache() {
             .map(str::to_string)
             .collect()
     };
-    let fresh = run(&[]);
-    let cached = run(&[]);
+    let fresh = run();
+    let cached = run();
     assert!(cached.contains("(from the cache)"), "{cached}");
     assert!(!wheres(&fresh).is_empty(), "{fresh}");
     assert_eq!(wheres(&fresh), wheres(&cached));
@@ -205,11 +186,25 @@ fn a_collision_names_both_bodies_where_they_are_and_how_deep() {
     // Both grippers' fingers touched: their centres lie the tool's gripper spacing apart
     // (0.60 m, `spacing` in robots/tools/study-gripper-nailer.toml), and the two points of contact are one rigid motion apart in
     // both frames (the wall frame is the cell frame moved).
-    let fingers: Vec<&&Value> = touches
+    // Each finger's touch is a cause of its own: gathered over every framing cause.
+    let args = [
+        "why",
+        model.to_str().unwrap(),
+        "0y81T5OQ921PKefugNkz2z/9",
+        "--json",
+    ];
+    let json: Value = serde_json::from_str(&framewright(&args)).unwrap();
+    let fingers: Vec<&Value> = json["elements"][0]["answer"]["causes"]
+        .as_array()
+        .unwrap()
         .iter()
+        .filter(|c| c["stage"] == "framing")
+        .flat_map(|c| c["located"].as_array().unwrap())
+        .filter(|l| l["kind"] == "touch")
         .filter(|t| t["body_a"].as_str().unwrap().contains("gripper"))
         .collect();
-    if fingers.len() == 2 {
+    assert_eq!(fingers.len(), 2, "{cause}");
+    {
         let (a, b) = (fingers[0], fingers[1]);
         let apart = dist(xyz(&a["centre_a"]), xyz(&b["centre_a"]));
         assert!((apart - 0.6).abs() < 0.005, "fingers {apart} m apart");

@@ -41,6 +41,20 @@ pub fn shared_path(relative: &str) -> Option<PathBuf> {
     }
 }
 
+/// `framewright ARGS…`, which must succeed: its standard output.
+pub fn framewright_ok(args: &[&str]) -> String {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_framewright"))
+        .args(args)
+        .output()
+        .expect("framewright runs");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8 output")
+}
+
 /// `framewright synth block ARGS… -o DIR/block.ifc`: a generated model for a test.
 pub fn synth_block(dir: &Path, args: &[&str]) -> PathBuf {
     let path = dir.join("block.ifc");
