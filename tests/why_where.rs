@@ -106,7 +106,9 @@ fn a_piece_modelled_above_its_support_says_how_far_it_dropped_and_onto_what() {
     let gap = releases[0]["gap"].as_f64().unwrap();
     assert!((gap - 0.021).abs() < 0.001, "released {gap} m above");
     assert!(!releases[0]["below"].as_str().unwrap().is_empty());
-    // The remedy moves the piece back by what it is off, not checked by a simulation.
+    // The remedy moves the piece back by what it is off: 20 mm back across the wall, which
+    // runs along the model's x with its faces at y = 0 and y = 0.0889 (−y in the model), and
+    // a new simulation with it moved frames it.
     let remedy = cause["remedies"]
         .as_array()
         .unwrap()
@@ -117,7 +119,17 @@ fn a_piece_modelled_above_its_support_says_how_far_it_dropped_and_onto_what() {
         (remedy["value"].as_f64().unwrap() + 0.020).abs() < 0.001,
         "{remedy}"
     );
-    assert_eq!(remedy["checked"], false);
+    let by = xyz(&remedy["piece_move"]["by"]);
+    assert!(dist(by, [0.0, -0.020, 0.0]) < 0.001, "{remedy}");
+    assert_eq!(remedy["piece_move"]["piece"], "2nv91WmrtNJ_0CsN4f5WS5");
+    assert_eq!(remedy["checked"], true, "{remedy}");
+    assert!(
+        remedy["text"]
+            .as_str()
+            .unwrap()
+            .ends_with("checked by simulating the wall again with the piece moved: framed"),
+        "{remedy}"
+    );
     // The text says it in the first lines.
     let text = framewright(&[
         "why",

@@ -197,6 +197,47 @@ impl Robot {
         Ok(opw)
     }
 
+    /// This arm with every length multiplied by `k`: joint origins, link shapes, the closed
+    /// form's parameters, the published reach; a prismatic joint's travel too. Joint angle
+    /// limits, speeds and the mounting stay. What a remedy checks "a robot like this one with
+    /// more reach" against.
+    pub fn scaled(&self, k: f64) -> Robot {
+        let mut r = self.clone();
+        let stretch = |iso: &mut Isometry3<f64>| iso.translation.vector *= k;
+        for j in &mut r.joints {
+            stretch(&mut j.origin);
+            if j.kind == JointKind::Prismatic {
+                j.lower *= k;
+                j.upper *= k;
+            }
+        }
+        for (origin, _) in &mut r.tip_steps {
+            stretch(origin);
+        }
+        stretch(&mut r.tip_offset);
+        for link in &mut r.links {
+            for s in link.collisions.iter_mut().chain(link.visuals.iter_mut()) {
+                stretch(&mut s.origin);
+                s.shape = s.shape.scaled(k);
+            }
+        }
+        let scale_opw = |p: &mut OpwParams| {
+            for v in [
+                &mut p.a1, &mut p.a2, &mut p.b, &mut p.c1, &mut p.c2, &mut p.c3, &mut p.c4,
+            ] {
+                *v *= k;
+            }
+        };
+        if let Some(p) = &mut r.meta.opw {
+            scale_opw(p);
+        }
+        if let Some(o) = &mut r.opw {
+            scale_opw(&mut o.p);
+        }
+        r.meta.reach = r.meta.reach.map(|v| v * k);
+        r
+    }
+
     /// Number of moving joints.
     pub fn dof(&self) -> usize {
         self.active.len()
@@ -555,4 +596,37 @@ fn shapes<'a>(
         });
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::robot_names;
+    use super::*;
+
+    #[test]
+    fn a_scaled_arm_is_the_arm_k_times_larger() {
+        let q = [0.3, -0.4, 0.5, 0.7, -0.9, 1.1];
+        for name in robot_names() {
+            let robot = Robot::load(name).unwrap();
+            let k = 1.37;
+            let big = robot.scaled(k);
+            let q = &q[..robot.dof()];
+            // Every link k times as far from the base, turned as before.
+            for (a, b) in robot.fk_all(q).iter().zip(big.fk_all(q)) {
+                let d = (a.translation.vector * k - b.translation.vector).norm();
+                assert!(d < 1e-12, "{name}: {d}");
+                assert!(a.rotation.angle_to(&b.rotation) < 1e-12, "{name}");
+            }
+            // The closed form still matches the chain, and reaches k times as far.
+            if let Some(opw) = &big.opw {
+                let q6: [f64; 6] = q.try_into().unwrap();
+                let chain = big.fk_tip_unmounted(q);
+                let own = opw.forward(&q6);
+                let d = (chain.translation.vector - own.translation.vector).norm();
+                assert!(d < 1e-9, "{name}: {d}");
+                let (_, far) = robot.opw.as_ref().unwrap().shoulder_reach();
+                assert!((opw.shoulder_reach().1 - far * k).abs() < 1e-12, "{name}");
+            }
+        }
+    }
 }

@@ -26,6 +26,24 @@ impl Shape {
             Shape::Sphere { radius } => 4.0 / 3.0 * PI * radius.powi(3),
         }
     }
+
+    /// The shape with every length multiplied by `k`.
+    pub fn scaled(&self, k: f64) -> Shape {
+        match *self {
+            Shape::Box { half_extents: h } => Shape::Box {
+                half_extents: h.map(|v| v * k),
+            },
+            Shape::Cylinder { radius, length } => Shape::Cylinder {
+                radius: radius * k,
+                length: length * k,
+            },
+            Shape::Capsule { radius, length } => Shape::Capsule {
+                radius: radius * k,
+                length: length * k,
+            },
+            Shape::Sphere { radius } => Shape::Sphere { radius: radius * k },
+        }
+    }
 }
 
 /// A shape and where it sits in its owner's frame.

@@ -122,13 +122,19 @@ pub fn load_model_facts(
     let model = super::open_model(model)?;
     let mut cell = load_cell(&inputs.cell, inputs.offset_x.as_deref())?;
     cell.panel_mode = inputs.panels;
+    let facts = model_and_cell_facts(&model, &cell, inputs);
+    Ok((model, cell, facts))
+}
+
+/// The facts of `model` (contacts within `--contact-tolerance`) and of `cell`.
+pub fn model_and_cell_facts(model: &Model, cell: &Cell, inputs: &ReasoningInputs) -> Facts {
     let contacts = ContactOptions {
-        tolerance: contact_tolerance_mm / 1000.0,
+        tolerance: inputs.contact_tolerance / 1000.0,
         ..ContactOptions::default()
     };
-    let mut facts = model_facts(&model, &contacts);
-    facts.extend(cell_facts(&cell));
-    Ok((model, cell, facts))
+    let mut facts = model_facts(model, &contacts);
+    facts.extend(cell_facts(cell));
+    facts
 }
 
 pub fn rule_base(rules_dir: &Option<PathBuf>) -> RuleEngine {

@@ -3,12 +3,14 @@
 //! keys and rule lines; or which rule could have derived a tuple and which
 //! condition failed.
 
-use super::check::{ReasoningInputs, load_inputs, load_model_facts, rules_in_force};
+use super::check::{
+    ReasoningInputs, load_inputs, load_model_facts, model_and_cell_facts, rules_in_force,
+};
 use super::{CmdResult, Failure, print_stdout};
 use framewright::cache::Cache;
 use framewright::explain::render::{render_answer, render_why, render_why_not};
 use framewright::explain::why::{
-    Context, WhyError, element_walls_split, name_walls, resolve_element, why, why_not,
+    Context, WhyError, WhyReport, element_walls_split, name_walls, resolve_element, why, why_not,
 };
 use framewright::frame::Ask;
 use framewright::frame::containers::{containers_of, restrict_to_containers};
@@ -30,7 +32,7 @@ pub struct WhyArgs {
     /// A piece id, an IFC GlobalId or an entity `#id`; or a panel (`W1-P2`), a plate segment
     /// (`PLATE~2`), an added end stud (`STUD~end2`) or a site piece (`CAP~lap1`) of the plan.
     pub id: String,
-    /// Print every verdict's derivation tree, not only the answer and its causes' trees.
+    /// Print every verdict's derivation tree, not only the answer and its first cause's tree.
     #[arg(long, alias = "tree")]
     pub verbose: bool,
     #[command(flatten)]
@@ -91,6 +93,7 @@ fn simulate_walls(
     facts: &mut framewright::frame::Facts,
     whole: Option<&framewright::frame::Facts>,
     ids: &[String],
+    cache: Option<&Cache>,
 ) -> Result<(Vec<Simulated>, Option<framewright::ifc::Model>), Failure> {
     if c.no_simulate {
         return Ok((Vec::new(), None));
@@ -147,14 +150,6 @@ fn simulate_walls(
     } else {
         None
     };
-    let cache = if c.no_cache {
-        None
-    } else {
-        c.cache_dir
-            .clone()
-            .or_else(super::cache::default_dir)
-            .map(Cache::new)
-    };
     let mut out = Vec::new();
     for wall in walls {
         let options = SimOptions {
@@ -164,7 +159,7 @@ fn simulate_walls(
         };
         let (sim, counts) = Run::new(model, cell, &options)
             .limits(super::rule_limits()?)
-            .cache(cache.as_ref())
+            .cache(cache)
             .wall_facts(whole)?;
         facts.extend(sim);
         out.push(Simulated {
@@ -197,6 +192,17 @@ fn failure(e: WhyError) -> Failure {
 }
 
 impl Common {
+    /// The cache of simulated walls, none with `--no-cache`.
+    fn cache(&self) -> Option<Cache> {
+        if self.no_cache {
+            return None;
+        }
+        self.cache_dir
+            .clone()
+            .or_else(super::cache::default_dir)
+            .map(Cache::new)
+    }
+
     /// What the wall's simulation cannot take, refused before the model is read.
     fn check_simulation(&self) -> Result<(), Failure> {
         if self.no_simulate {
@@ -222,38 +228,49 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
                 args.id
             ))
         })?;
-        return print_panel_answer(c, &args.model, &cell.name, &args.id, &answer);
+        // A plate segment or an added stud is also a piece the executor framed: its verdicts
+        // follow the cut, from its panel's simulation.
+        let of = args.id.split_once('~').map(|(of, _)| of);
+        if c.no_simulate || of.is_none_or(|of| resolve_element(&model, of).is_err()) {
+            return print_panel_answer(c, &args.model, &cell.name, &args.id, &answer);
+        }
+        let rules = Rules {
+            base: &base,
+            user_files: &user_files,
+        };
+        let of = of.unwrap_or_default();
+        let (mut simulated, mut reports) = explain_part(
+            c,
+            &rules,
+            &model,
+            &cell,
+            &whole,
+            of,
+            &args.id,
+            c.cache().as_ref(),
+        )?;
+        let names = panels_by_piece(&plan);
+        name_walls(&mut reports, &names);
+        label_simulated(&mut simulated, &names, &reports);
+        return print_part_answer(c, &args, &cell.name, &answer, &simulated, &reports);
     }
-    // Only the element's containers matter (see `frame::containers`): the placement search
-    // and the rules run over them alone.
-    let pieces = resolve_element(&model, &args.id).map_err(failure)?;
-    let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
-    let mut facts = restrict_to_containers(&whole, &containers_of(&whole, &ids));
-    Ask::new(&base)
-        .within(super::rule_limits()?)
-        .place(&mut facts, &cell)?;
-    let (mut simulated, panelized) = simulate_walls(
-        c,
-        &model,
-        &cell,
-        &mut facts,
-        Some(&whole),
-        std::slice::from_ref(&args.id),
-    )?;
     let names = panels_by_piece(&plan);
-    for s in &mut simulated {
-        s.label = names.get(&s.wall).map(PanelOf::label);
-    }
-    let ctx = Context {
-        model: panelized.as_ref().unwrap_or(&model),
-        facts: &facts,
+    let rules = Rules {
         base: &base,
         user_files: &user_files,
-        limits: super::rule_limits()?,
-        cell: Some(&cell),
     };
-    let mut reports = why(&ctx, &args.id).map_err(failure)?;
+    let (mut simulated, mut reports) = explain_element(
+        c,
+        &rules,
+        &model,
+        &cell,
+        &whole,
+        &args.id,
+        c.cache().as_ref(),
+    )?;
     name_walls(&mut reports, &names);
+    label_simulated(&mut simulated, &names, &reports);
+    check_piece_moves(c, &rules, &model, &cell, &mut reports)?;
     let text = if c.json {
         #[derive(Serialize)]
         struct Elements<'a, T> {
@@ -270,20 +287,7 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
             },
         })?
     } else {
-        let mut text = String::new();
-        for s in &simulated {
-            text.push_str(&format!(
-                "simulated {}{}\n",
-                s.label
-                    .clone()
-                    .unwrap_or_else(|| format!("wall {}", s.wall)),
-                if s.from_cache {
-                    " (from the cache)"
-                } else {
-                    ""
-                }
-            ));
-        }
+        let mut text = simulated_lines(&simulated);
         if c.no_simulate {
             text.push_str("not simulated (--no-simulate): plan verdicts only\n");
         }
@@ -295,6 +299,129 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
         text
     };
     print_stdout(&text)
+}
+
+/// The rule base and user rule files in force.
+struct Rules<'a> {
+    base: &'a framewright::frame::RuleEngine,
+    user_files: &'a [PathBuf],
+}
+
+/// The reports on `id` over `whole` (the model's and the cell's facts): only the element's
+/// containers matter (see `frame::containers`), so the placement search and the rules run over
+/// them alone; its walls simulated through `cache`.
+fn explain_element(
+    c: &Common,
+    rules: &Rules,
+    model: &framewright::ifc::Model,
+    cell: &framewright::cell::Cell,
+    whole: &framewright::frame::Facts,
+    id: &str,
+    cache: Option<&Cache>,
+) -> Result<(Vec<Simulated>, Vec<WhyReport>), Failure> {
+    explain_part(c, rules, model, cell, whole, id, id, cache)
+}
+
+/// As `explain_element`, for `id` (a piece of the model, or a plate segment or added stud of a
+/// split wall) that `of` (a piece of the model: the plate it is cut from) puts in its wall.
+#[allow(clippy::too_many_arguments)]
+fn explain_part(
+    c: &Common,
+    rules: &Rules,
+    model: &framewright::ifc::Model,
+    cell: &framewright::cell::Cell,
+    whole: &framewright::frame::Facts,
+    of: &str,
+    id: &str,
+    cache: Option<&Cache>,
+) -> Result<(Vec<Simulated>, Vec<WhyReport>), Failure> {
+    let pieces = resolve_element(model, of).map_err(failure)?;
+    let ids: BTreeSet<&str> = pieces.iter().map(|p| p.id.as_str()).collect();
+    let mut facts = restrict_to_containers(whole, &containers_of(whole, &ids));
+    Ask::new(rules.base)
+        .within(super::rule_limits()?)
+        .place(&mut facts, cell)?;
+    let (simulated, panelized) = simulate_walls(
+        c,
+        model,
+        cell,
+        &mut facts,
+        Some(whole),
+        &[of.to_string()],
+        cache,
+    )?;
+    let ctx = Context {
+        model: panelized.as_ref().unwrap_or(model),
+        facts: &facts,
+        base: rules.base,
+        user_files: rules.user_files,
+        limits: super::rule_limits()?,
+        cell: Some(cell),
+    };
+    let reports = why(&ctx, id).map_err(failure)?;
+    Ok((simulated, reports))
+}
+
+/// Checks each remedy that moves a piece in the model by simulating its wall again (no cache)
+/// with the piece moved: checked when the piece is then framed; otherwise the remedy becomes
+/// a search that found none, with the status the new run gave.
+fn check_piece_moves(
+    c: &Common,
+    rules: &Rules,
+    model: &framewright::ifc::Model,
+    cell: &framewright::cell::Cell,
+    reports: &mut [WhyReport],
+) -> Result<(), Failure> {
+    for report in reports.iter_mut() {
+        for cause in report.answer.causes.iter_mut() {
+            let mut kept = Vec::new();
+            for mut remedy in std::mem::take(&mut cause.remedies) {
+                let Some(m) = remedy.piece_move.clone() else {
+                    kept.push(remedy);
+                    continue;
+                };
+                let Some(moved) = moved_piece(model, &m.piece, &m.by) else {
+                    kept.push(remedy);
+                    continue;
+                };
+                let whole = model_and_cell_facts(&moved, cell, &c.inputs);
+                let (_, after) = explain_element(c, rules, &moved, cell, &whole, &m.piece, None)?;
+                let status = after
+                    .iter()
+                    .flat_map(|r| &r.answer.statuses)
+                    .find(|s| s.stage == "framing")
+                    .map_or("not simulated", |s| s.status.as_str());
+                if status == "framed" {
+                    remedy.checked = true;
+                    remedy.text = match remedy.text.split_once("; not checked") {
+                        Some((head, _)) => head.to_string(),
+                        None => remedy.text.clone(),
+                    } + "; checked by simulating the wall again with the piece moved: framed";
+                    kept.push(remedy);
+                } else {
+                    cause.no_remedy.push(format!(
+                        "moving it {:.1} mm onto the surface beneath it: simulated again, it is {status}",
+                        remedy.value.abs() * 1000.0
+                    ));
+                }
+            }
+            cause.remedies = kept;
+        }
+    }
+    Ok(())
+}
+
+/// The model with `piece` moved by `by` (model coordinates, m); none when the model has no
+/// such piece (a plate segment of a cut wall).
+fn moved_piece(
+    model: &framewright::ifc::Model,
+    piece: &str,
+    by: &[f64; 3],
+) -> Option<framewright::ifc::Model> {
+    let mut pieces = model.pieces().to_vec();
+    let p = pieces.iter_mut().find(|p| p.id == piece)?;
+    p.obox.centre += nalgebra::Vector3::from(*by);
+    Some(model.with_pieces(pieces))
 }
 
 pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
@@ -311,7 +438,8 @@ pub fn run_why_not(args: WhyNotArgs) -> CmdResult {
     }
     let (model, cell, mut facts) = load_inputs(&args.model, &c.inputs, &base)?;
     let ids = piece_ids_in(&model, &args.tuple);
-    let (_, panelized) = simulate_walls(c, &model, &cell, &mut facts, None, &ids)?;
+    let (_, panelized) =
+        simulate_walls(c, &model, &cell, &mut facts, None, &ids, c.cache().as_ref())?;
     let ctx = Context {
         model: panelized.as_ref().unwrap_or(&model),
         facts: &facts,
@@ -347,6 +475,98 @@ fn plan_of(
         .placed(facts, cell)?;
     let plan = Plan::from_reasoned(model, &reasoned)?;
     Ok((plan, reasoned.relations))
+}
+
+/// A plate segment's or added stud's answer: how the plan made it, then its verdicts.
+fn print_part_answer(
+    c: &Common,
+    args: &WhyArgs,
+    cell: &str,
+    panel: &panel_why::PanelWhy,
+    simulated: &[Simulated],
+    reports: &[WhyReport],
+) -> CmdResult {
+    let text = if c.json {
+        #[derive(Serialize)]
+        struct Part<'a> {
+            panel: &'a panel_why::PanelWhy,
+            simulated: &'a [Simulated],
+            elements: &'a [WhyReport],
+        }
+        json(&Envelope {
+            model: args.model.display().to_string(),
+            cell,
+            query: &args.id,
+            answer: Part {
+                panel,
+                simulated,
+                elements: reports,
+            },
+        })?
+    } else {
+        let mut text = panel.to_text();
+        if !args.verbose {
+            // How the cut was decided is the plan's answer: its first line here, all of it
+            // with --verbose.
+            let first = text.lines().next().unwrap_or_default().to_string();
+            text = format!("{first}\n  (how the plan cut it: --verbose)\n");
+        }
+        text.push('\n');
+        text.push_str(&simulated_lines(simulated));
+        text.push_str(&if args.verbose {
+            render_why(reports)
+        } else {
+            render_answer(reports)
+        });
+        text
+    };
+    print_stdout(&text)
+}
+
+/// Names each simulated wall as `plan` does.
+fn label_simulated(
+    simulated: &mut [Simulated],
+    names: &std::collections::BTreeMap<String, PanelOf>,
+    reports: &[WhyReport],
+) {
+    // The one wall simulated for an element is the element's.
+    let only = (simulated.len() == 1)
+        .then(|| reports.iter().find_map(|r| r.wall_label.clone()))
+        .flatten();
+    for s in simulated {
+        // A panel of a split wall is keyed in the cut model by a piece the plan does not
+        // list (a plate's id before the cut): named as the elements it holds are.
+        s.label = names
+            .get(&s.wall)
+            .map(PanelOf::label)
+            .or_else(|| {
+                reports
+                    .iter()
+                    .find(|r| r.wall.as_deref() == Some(s.wall.as_str()))
+                    .and_then(|r| r.wall_label.clone())
+            })
+            .or_else(|| only.clone());
+    }
+}
+
+/// `simulated LABEL [(from the cache)]`, one line per wall.
+fn simulated_lines(simulated: &[Simulated]) -> String {
+    simulated
+        .iter()
+        .map(|s| {
+            format!(
+                "simulated {}{}\n",
+                s.label
+                    .clone()
+                    .unwrap_or_else(|| format!("wall {}", s.wall)),
+                if s.from_cache {
+                    " (from the cache)"
+                } else {
+                    ""
+                }
+            )
+        })
+        .collect()
 }
 
 fn print_panel_answer(

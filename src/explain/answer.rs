@@ -31,6 +31,23 @@ fn nail_reason(message: &str) -> Option<NailReason<'_>> {
     Some(NailReason { subject, cause })
 }
 
+/// A message with each run of digits (and decimal points in it) as `#`: messages that differ
+/// only in their numbers read alike.
+fn numbers_aside(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut in_number = false;
+    for c in message.trim().chars() {
+        let digit = c.is_ascii_digit() || (in_number && c == '.');
+        if !digit {
+            out.push(c);
+        } else if !in_number {
+            out.push('#');
+        }
+        in_number = digit;
+    }
+    out
+}
+
 /// A nail's cause with this element's id as "it" and the other piece's as "the other piece".
 fn in_words(n: &NailReason, id: &str) -> String {
     let (pair, _) = n.subject.rsplit_once(" #").unwrap_or((&n.subject, ""));
@@ -89,7 +106,8 @@ fn find<'e>(e: &'e Explanation, relation: &str) -> Option<&'e Explanation> {
 pub fn answer(report: &WhyReport) -> Answer {
     let id = report.element.id.as_str();
     let mut out = Answer::default();
-    // Causes keyed by (stage, component, rule): nails of one rule fold into one.
+    // Causes keyed by (stage, component, rule, message but its numbers): nails failing alike
+    // fold into one; a nail failing otherwise under the same rule is a cause of its own.
     let mut causes: Vec<Cause> = Vec::new();
     // Nails not driven because a piece was not framed, by kind.
     let mut skipped: Vec<Consequence> = Vec::new();
@@ -119,7 +137,8 @@ pub fn answer(report: &WhyReport) -> Answer {
                     continue;
                 }
                 let same = causes.iter_mut().find(|c| {
-                    nail.is_some()
+                    nail.as_ref()
+                        .is_some_and(|n| numbers_aside(&c.message) == numbers_aside(n.cause))
                         && !c.subjects.is_empty()
                         && c.stage == stage
                         && c.component == component
@@ -205,6 +224,18 @@ fn cause(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn messages_differing_in_their_numbers_read_alike() {
+        assert_eq!(
+            numbers_aside("beyond reach: 3.477 m, reaches 2.377 m (1100 mm too far)"),
+            numbers_aside("beyond reach: 3.5 m, reaches 2.377 m (1123 mm too far)")
+        );
+        assert_ne!(
+            numbers_aside("every solution collides: link_5 with floor"),
+            numbers_aside("every solution collides: tool gripper_2_jaws finger with piece A/7")
+        );
+    }
 
     #[test]
     fn nail_reasons_split_into_the_nail_and_its_cause() {

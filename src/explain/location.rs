@@ -103,7 +103,7 @@ fn uvw(p: &[f64; 3]) -> String {
 }
 
 /// The rows of `R` in the engine (none when the program does not declare it).
-fn rows<R: Row>(engine: &Engine) -> Result<Vec<R>, LogicError> {
+pub(super) fn rows<R: Row>(engine: &Engine) -> Result<Vec<R>, LogicError> {
     if engine.program().relation(R::RELATION).is_none() {
         return Ok(Vec::new());
     }

@@ -2,7 +2,8 @@
 //! take (beyond reach, past a joint limit), the smallest move of the wall along the robot's x
 //! (the cell's `offset_x`) and along its y (`centre_y`) at which the place pose and the pose
 //! the gripper descends from both solve, and each other shipped robot that, mounted where this
-//! one is, takes both; for a pose beyond reach also the reach a robot would need. Each move and
+//! one is, takes both; for a pose beyond reach also the reach a robot would need, found as the
+//! smallest scale of this arm (every length, joint limits kept) that takes both. Each move and
 //! robot is checked as the executor plans a place (`frame::placement::reached_held_at`: exact
 //! IK within the joint limits, the arm and tool above the floor, the piece held at its middle
 //! or shifted along it as two grippers may hold it); collisions with the cell's fixtures and
@@ -10,13 +11,16 @@
 //! down with the tool tilted, which the check does not try: a remedy is then sufficient, not
 //! always the smallest. For a piece that came to rest off its target because its target lies
 //! above what is beneath it, the move of its modelled position onto that surface (from the gap
-//! the executor measured at the release; not re-simulated, and said so).
+//! the executor measured at the release), in the model's coordinates; the caller checks it by
+//! simulating the wall again with the piece moved (`PieceMove`).
 
-use super::location::Located;
+use super::location::{Located, rows};
 use super::report::{WhyReport, walk};
 use crate::cell::{Cell, Robot, robot_names};
 use crate::frame::placement::reached_held_at;
-use crate::frame::rows::{FramingTarget, PieceSize, Row, SimIkFailed, WallOffsetX};
+use crate::frame::rows::{
+    FramingTarget, FramingTargetWall, PieceSize, Row, SimIkFailed, WallAxes, WallOf, WallOffsetX,
+};
 use crate::logic::provenance::Explanation;
 use crate::logic::{Engine, LogicError};
 use crate::sim::RELEASE_GAP;
@@ -48,6 +52,18 @@ pub struct Remedy {
     pub checked: bool,
     /// The change in words, with how it was checked.
     pub text: String,
+    /// For a change of a piece's modelled position: the move, which the caller checks by
+    /// simulating the wall again.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub piece_move: Option<PieceMove>,
+}
+
+/// A piece moved in the model.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PieceMove {
+    pub piece: String,
+    /// The move in the model's coordinates (m).
+    pub by: [f64; 3],
 }
 
 /// A place pose the arm could not take.
@@ -101,6 +117,7 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
                 value,
                 unit: "m",
                 checked: true,
+                piece_move: None,
                 text: format!(
                     "lay the wall at offset_x = {value:.3} m ({dx:+.3} m along the robot's x, now {:.3} m{}); {CHECKED_BY}",
                     failed.offset_x,
@@ -121,6 +138,7 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
                 value,
                 unit: "m",
                 checked: true,
+                piece_move: None,
                 text: format!(
                     "centre the wall at centre_y = {value:.3} m ({dy:+.3} m along the robot's y, now {now:.3} m{}); {CHECKED_BY}",
                     grip(s)
@@ -148,6 +166,7 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
                 value: rated,
                 unit: "m",
                 checked: true,
+                piece_move: None,
                 text: format!(
                     "the {} ({name}, rated reach {rated:.2} m) mounted where this one is{}; {CHECKED_BY}",
                     other.robot.meta.description.as_deref().unwrap_or(name),
@@ -161,17 +180,61 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
             .push("no other shipped robot takes it from this base".into());
     }
     if let Some((needed, reach)) = failed.beyond {
-        out.remedies.push(Remedy {
+        out.remedies.push(reach_remedy(cell, needed, reach, |c| {
+            held(c, Vector3::zeros())
+        }));
+    }
+    out
+}
+
+/// The arm scaled up at most this much (2.0: twice the reach) when looking for the reach a
+/// pose beyond reach needs, in SCALE_STEP steps.
+const SCALE_LIMIT: f64 = 2.0;
+const SCALE_STEP: f64 = 0.01;
+
+/// The reach that takes a pose `needed` m from the shoulder (the arm reaching `reach`): the
+/// smallest scale of this arm, from needed / reach up in SCALE_STEP steps, at which `held`
+/// takes the place and approach poses (every length of the arm scaled, joint limits kept).
+/// Unchecked, with the distance the IK gave, when no scale up to SCALE_LIMIT does.
+fn reach_remedy(
+    cell: &Cell,
+    needed: f64,
+    reach: f64,
+    held: impl Fn(&Cell) -> Option<f64>,
+) -> Remedy {
+    let from = (needed / reach / SCALE_STEP).ceil() as i64;
+    let to = (SCALE_LIMIT / SCALE_STEP).round() as i64;
+    let found = (from.max(1)..=to).find_map(|n| {
+        let k = n as f64 * SCALE_STEP;
+        let mut scaled = cell.clone();
+        scaled.robot = cell.robot.scaled(k);
+        held(&scaled).map(|_| k)
+    });
+    match found {
+        Some(k) => {
+            let value = mm(reach * k);
+            Remedy {
+                change: "reach".into(),
+                value,
+                unit: "m",
+                checked: true,
+                piece_move: None,
+                text: format!(
+                    "a robot whose wrist centre reaches {value:.3} m from its shoulder (this one {reach:.3} m; the pose needs {needed:.3} m): this arm scaled ×{k:.2}, mounted where it is, takes the pose; {CHECKED_BY}"
+                ),
+            }
+        }
+        None => Remedy {
             change: "reach".into(),
             value: mm(needed),
             unit: "m",
             checked: false,
+            piece_move: None,
             text: format!(
-                "a robot whose wrist centre reaches {needed:.3} m from its shoulder (this one {reach:.3} m); not checked: computed from the IK's distance, joint limits and the floor not tried"
+                "a robot whose wrist centre reaches {needed:.3} m from its shoulder (this one {reach:.3} m); not checked: this arm scaled up to ×{SCALE_LIMIT:.1} does not take the pose (joint limits, the floor), so another arm's shape is needed"
             ),
-        });
+        },
     }
-    out
 }
 
 /// The smallest move (m, by size, the negative side first on a tie) in SHIFT_STEP steps up to
@@ -193,27 +256,13 @@ fn mm(v: f64) -> f64 {
 /// refused (`sim_ik_failed(p, "place", …)`), reading the target, size and wall offset from
 /// the engine that explained it.
 pub fn attach(engine: &Engine, cell: &Cell, report: &mut WhyReport) -> Result<(), LogicError> {
-    // The first row of `R` whose key (`key` of the row) is `of`.
-    fn row_of<R: Row>(
-        engine: &Engine,
-        of: &str,
-        key: impl Fn(&R) -> &str,
-    ) -> Result<Option<R>, LogicError> {
-        if engine.program().relation(R::RELATION).is_none() {
-            return Ok(None);
-        }
-        Ok(engine
-            .relation(R::RELATION)?
-            .iter()
-            .filter_map(|t| R::read(t))
-            .find(|r| key(r) == of))
-    }
+    let piece = report.element.id.as_str();
+    let down = cell_down_in_model(engine, cell, piece)?;
     for cause in report.answer.causes.iter_mut() {
-        if let Some(r) = off_target_remedy(&cause.located) {
+        if let Some(r) = off_target_remedy(&cause.located, piece, down) {
             cause.remedies.push(r);
         }
     }
-    let piece = report.element.id.as_str();
     let (Some(target), Some(size)) = (
         row_of::<FramingTarget>(engine, piece, |r| r.p)?,
         row_of::<PieceSize>(engine, piece, |r| r.p)?,
@@ -244,11 +293,49 @@ pub fn attach(engine: &Engine, cell: &Cell, report: &mut WhyReport) -> Result<()
     Ok(())
 }
 
+/// The cell's down (−z) in the model's coordinates for the wall of `piece`, as the wall is laid
+/// (`framing_target_wall` in the robot frame, `wall_axes` in the model), when both are known.
+fn cell_down_in_model(
+    engine: &Engine,
+    cell: &Cell,
+    piece: &str,
+) -> Result<Option<Vector3<f64>>, LogicError> {
+    let Some(wall) = row_of::<WallOf>(engine, piece, |r| r.p)?.map(|r| r.w) else {
+        return Ok(None);
+    };
+    let (Some(laid), Some(axes)) = (
+        row_of::<FramingTargetWall>(engine, wall, |r| r.w)?,
+        row_of::<WallAxes>(engine, wall, |r| r.w)?,
+    ) else {
+        return Ok(None);
+    };
+    let in_wall = (cell.robot_base * laid.wall_to_robot)
+        .rotation
+        .inverse_transform_vector(&-Vector3::z());
+    Ok(Some(
+        axes.u * in_wall.x + axes.v * in_wall.y + axes.n * in_wall.z,
+    ))
+}
+
+/// The first row of `R` whose key (`key` of the row) is `of`.
+fn row_of<R: Row>(
+    engine: &Engine,
+    of: &str,
+    key: impl Fn(&R) -> &str,
+) -> Result<Option<R>, LogicError> {
+    Ok(rows::<R>(engine)?.into_iter().find(|r| key(r) == of))
+}
+
 /// For a piece released above what lies beneath it (more than the executor's release gap):
-/// the move of its modelled position that sets its target on that surface. Computed from the
-/// gap the executor measured beneath it at the release (a shape cast straight down), not
-/// checked by a new simulation.
-fn off_target_remedy(located: &[Located]) -> Option<Remedy> {
+/// the move of its modelled position that sets its target on that surface, along the cell's
+/// down as the wall is laid (`down`, model coordinates). Computed from the gap the executor
+/// measured beneath it at the release (a shape cast straight down); unchecked until the caller
+/// simulates the wall with the piece moved.
+fn off_target_remedy(
+    located: &[Located],
+    piece: &str,
+    down: Option<Vector3<f64>>,
+) -> Option<Remedy> {
     let (below, gap) = located.iter().find_map(|l| match l {
         Located::Release { below, gap } if !below.is_empty() => Some((below, *gap)),
         _ => None,
@@ -257,15 +344,28 @@ fn off_target_remedy(located: &[Located]) -> Option<Remedy> {
     if excess < OFF_SURFACE {
         return None;
     }
+    let by = down.map(|d| d * mm(excess));
+    let model_move = by.map_or_else(String::new, |b| {
+        format!(
+            ", i.e. by ({:.3}, {:.3}, {:.3}) m in the model",
+            b.x + 0.0,
+            b.y + 0.0,
+            b.z + 0.0
+        )
+    });
     Some(Remedy {
         change: "piece_position".to_string(),
         value: -mm(excess),
         unit: "m",
         checked: false,
         text: format!(
-            "model it {:.1} mm nearer the surface beneath it as the wall lies ({below}): its framing target lies that far above it, so it drops when released; not checked: computed from the gap measured beneath it at the release",
+            "model it {:.1} mm nearer the surface beneath it as the wall lies ({below}){model_move}: its framing target lies that far above it, so it drops when released; not checked: computed from the gap measured beneath it at the release",
             excess * 1000.0
         ),
+        piece_move: by.map(|b| PieceMove {
+            piece: piece.to_string(),
+            by: [b.x, b.y, b.z].map(|v| mm(v) + 0.0),
+        }),
     })
 }
 

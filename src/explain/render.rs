@@ -3,7 +3,7 @@
 //! numbers shortened, a fact already shown printed once, and long runs of
 //! input facts of one relation folded with a count. `--json` has everything.
 //! By default `why` prints the answer first (`render_answer`): each failure's cause with its
-//! numbers and what it led to, then only the causes' trees; `--verbose` prints every tree.
+//! numbers and what it led to, then the first cause's tree; `--verbose` prints every tree.
 
 use super::report::{Verdict, WhyNotNode, WhyNotReport, WhyReport};
 use super::words::{fact, origin_text};
@@ -43,7 +43,7 @@ fn element_line(s: &mut String, r: &WhyReport) {
 }
 
 /// The answer first: statuses, each cause with its numbers and what it led to, findings, the
-/// plan's verdicts; then the tree of each cause.
+/// plan's verdicts; then the first cause's tree (the others: `--verbose`).
 pub fn render_answer(reports: &[WhyReport]) -> String {
     let mut s = String::new();
     for (k, r) in reports.iter().enumerate() {
@@ -107,12 +107,18 @@ pub fn render_answer(reports: &[WhyReport]) -> String {
         if !a.plan.is_empty() {
             let _ = writeln!(s, "plan: {}", a.plan.join("; "));
         }
-        let trees: Vec<&Verdict> = a.causes.iter().map(|c| &r.verdicts[c.verdict]).collect();
-        if !trees.is_empty() {
-            s.push_str("\nhow each cause was derived:\n");
+        // The first cause's tree: the others are derived by rules shown in their `by` lines,
+        // and every tree under the answer would push it past a screen.
+        if let Some(first) = a.causes.first() {
+            s.push_str("\nhow the first cause was derived:\n");
+            render_verdict(&mut s, &r.verdicts[first.verdict], ANSWER_DEPTH);
         }
-        for v in trees {
-            render_verdict(&mut s, v, ANSWER_DEPTH);
+        if a.causes.len() > 1 {
+            let _ = writeln!(
+                s,
+                "({} more causes' derivations: --verbose)",
+                a.causes.len() - 1
+            );
         }
     }
     s.push_str("\n(every verdict's derivation: --verbose; the whole trees: --json)\n");
