@@ -1,8 +1,10 @@
 //! `why` on one element of every failure class a simulation produces, model by model and cell
 //! by cell (the Constructivity wall and TM3 on both study cells, the 3-storey model on the ABB
 //! cell, TM3 with a stud modelled proud of its wall): the element's first cause opens the
-//! answer, and the cause `simulate` reported is there with its numbers and where it happened, what it led to is one line per kind,
-//! a place pose the arm cannot take comes with a remedy that has a number, and the whole answer
+//! answer, and the cause `simulate` reported is there with its numbers and where it happened;
+//! what it led to is one line per kind; a place pose the arm cannot take and a piece off
+//! target come with a checked remedy that has a number (a pose refused for a collision with a
+//! remedy or why none); and the whole answer
 //! stays under 30 lines. The classes are read from `simulate --json`'s messages by this test's
 //! own table, so a class the executor starts to produce is swept too (as `other`).
 
@@ -165,13 +167,22 @@ fn check_answer(text: &str, class: &str, message: &str, at: &str) {
         n,
         "{at}: a kind of consequence on two lines\n{text}"
     );
-    // A place pose the arm cannot take: a remedy with a number, or what was searched.
-    if stage == "framing" && (kind == "beyond_reach" || kind == "joint_limit") {
+    // A place pose the arm cannot take, a piece off target: a remedy with a number, checked.
+    if stage == "framing" && ["beyond_reach", "joint_limit", "off_target"].contains(&kind) {
+        assert!(
+            block.iter().any(|l| l.starts_with("  would pass: ")
+                && l.chars().any(|c| c.is_ascii_digit())
+                && l.contains("; checked by ")),
+            "{at}: no checked remedy with a number\n{text}"
+        );
+    }
+    // A place pose refused otherwise: a remedy, or what was (not) searched.
+    if stage == "framing" && kind.starts_with("collides_") {
         assert!(
             block
                 .iter()
-                .any(|l| l.starts_with("  would pass: ") && l.chars().any(|c| c.is_ascii_digit())),
-            "{at}: no remedy with a number\n{text}"
+                .any(|l| l.starts_with("  would pass: ") || l.starts_with("  no remedy: ")),
+            "{at}: neither a remedy nor why none\n{text}"
         );
     }
     // One derivation tree, not one per verdict.

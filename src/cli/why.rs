@@ -249,6 +249,9 @@ pub fn run_why(args: WhyArgs) -> CmdResult {
             &args.id,
             c.cache().as_ref(),
         )?;
+        if reports.is_empty() {
+            return print_panel_answer(c, &args.model, &cell.name, &args.id, &answer);
+        }
         let names = panels_by_piece(&plan);
         name_walls(&mut reports, &names);
         label_simulated(&mut simulated, &names, &reports);
@@ -358,6 +361,10 @@ fn explain_part(
         limits: super::rule_limits()?,
         cell: Some(cell),
     };
+    if of != id && resolve_element(ctx.model, id).is_err() {
+        // A part of the plan the executor does not frame (a cap plate's lap, set on site).
+        return Ok((simulated, Vec::new()));
+    }
     let reports = why(&ctx, id).map_err(failure)?;
     Ok((simulated, reports))
 }
@@ -489,6 +496,7 @@ fn print_part_answer(
     let text = if c.json {
         #[derive(Serialize)]
         struct Part<'a> {
+            #[serde(flatten)]
             panel: &'a panel_why::PanelWhy,
             simulated: &'a [Simulated],
             elements: &'a [WhyReport],

@@ -87,8 +87,8 @@ pub struct Remedies {
     pub none_found: Vec<String>,
 }
 
-/// The remedies of a failed place in `cell`. Nothing when the pose solves as modelled (the
-/// failure then lies in what this check does not cover).
+/// The remedies of a failed place in `cell`. None when the pose solves as modelled (the
+/// failure then lies in what this check does not cover, and `none_found` says so).
 pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
     let mut out = Remedies::default();
     // The grip shift (m from the piece's middle) at which the moved pose is taken.
@@ -100,6 +100,9 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
         )
     };
     if held(cell, Vector3::zeros()).is_some() {
+        out.none_found.push(
+            "none searched: the place pose solves as modelled by the check remedies are verified by (IK, joint limits, floor, tool pointing down), so what refused it lies beyond that check (the executor's own collision test against the floor, the cell's fixtures or placed pieces, or its grip)".into(),
+        );
         return out;
     }
     let grip = |s: f64| match s {
