@@ -90,9 +90,6 @@ impl Opw {
         let c = pose.translation.vector - z * p.c4;
 
         let nx1 = (c.x * c.x + c.y * c.y - p.b * p.b).max(0.0).sqrt() - p.a1;
-        let tmp1 = c.y.atan2(c.x);
-        let tmp2 = p.b.atan2(nx1 + p.a1);
-        let theta1 = [tmp1 - tmp2, tmp1 + tmp2 - PI];
         let tmp3 = c.z - p.c1;
         let s1_2 = nx1 * nx1 + tmp3 * tmp3;
         let tmp4 = nx1 + 2.0 * p.a1;
@@ -106,13 +103,23 @@ impl Opw {
             shoulder_distance: [s1, s2],
             wrist_angles: [0.0; 8],
         };
+        // The elbow's cosine rule (the loop's first test below), before any angle: a pose
+        // beyond reach from both shoulder positions costs no trigonometry (a track's
+        // placement search asks many such).
+        let elbow = |s: f64, s_2: f64| safe_acos((s_2 + c2_2 - kappa_2) / (2.0 * s * p.c2));
+        if elbow(s1, s1_2).is_none() && elbow(s2, s2_2).is_none() {
+            return out;
+        }
+        let tmp1 = c.y.atan2(c.x);
+        let tmp2 = p.b.atan2(nx1 + p.a1);
+        let theta1 = [tmp1 - tmp2, tmp1 + tmp2 - PI];
         let tmp9 = 2.0 * p.c2 * kappa_2.sqrt();
         let tmp10 = p.a2.atan2(p.c3);
         // Front shoulder (θ1 = tmp1 - tmp2) and back shoulder (θ1 + π) branches.
         for (branch, (s, s_2, reach_x)) in
             [(s1, s1_2, nx1), (s2, s2_2, tmp4)].into_iter().enumerate()
         {
-            let Some(a) = safe_acos((s_2 + c2_2 - kappa_2) / (2.0 * s * p.c2)) else {
+            let Some(a) = elbow(s, s_2) else {
                 continue;
             };
             let Some(b) = safe_acos((s_2 - c2_2 - kappa_2) / tmp9) else {
