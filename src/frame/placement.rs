@@ -501,6 +501,12 @@ fn reached_together(cell: &Cell, poses: &[Isometry3<f64>], tcp: &Isometry3<f64>)
     let Some(first) = poses.first() else {
         return true;
     };
+    if poses
+        .iter()
+        .any(|p| beyond_reach_along_the_rail(cell, track, p, tcp))
+    {
+        return false;
+    }
     let abeam = track.abeam(&Point3::from((cell.robot_base * first).translation.vector));
     track.positions_from(abeam).into_iter().any(|s| {
         // Robot frame at home → robot frame with the carriage at s.
@@ -509,6 +515,48 @@ fn reached_together(cell: &Cell, poses: &[Isometry3<f64>], tcp: &Isometry3<f64>)
             .iter()
             .all(|p| solves_above_floor(cell, &(shift * p), tcp))
     })
+}
+
+/// Whether the closed form's wrist centre for `pose` (robot frame, carriage at home) lies beyond
+/// the arm's reach from every carriage position: on a level rail the wrist centre's height
+/// above the shoulder stays put and its distance from the base axis is least at the position
+/// abeam of it (within the travel), where both shoulder distances are least too while the
+/// wrist lies outside the shoulder's offset; beyond reach there, the IK says "out of reach" at
+/// every position the search would try. False when that cannot be shown (no closed form, a
+/// rail that is not level in the arm's frame, a wrist inside the shoulder offset).
+fn beyond_reach_along_the_rail(
+    cell: &Cell,
+    track: &crate::cell::track::Track,
+    pose: &Isometry3<f64>,
+    tcp: &Isometry3<f64>,
+) -> bool {
+    let Some(opw) = &cell.robot.opw else {
+        return false;
+    };
+    let p = &opw.p;
+    let wrist = pose * tcp.inverse() * Point3::new(0.0, 0.0, -p.c4);
+    // The wrist centre in base_link with the carriage at s: affine in s.
+    let at = |s: f64| {
+        cell.robot.mount.inverse() * (track.base_at(s).inverse() * cell.robot_base) * wrist
+    };
+    let (a, b) = (at(0.0), at(1.0) - at(0.0));
+    let along = b.xy().norm_squared();
+    if b.z.abs() > 1e-9 || along < 1e-12 {
+        return false;
+    }
+    let s = (-a.coords.xy().dot(&b.xy()) / along).clamp(track.travel[0], track.travel[1]);
+    let nearest = a + b * s;
+    let rho_2 = nearest.coords.xy().norm_squared() - p.b * p.b;
+    let front = rho_2.max(0.0).sqrt() - p.a1;
+    let back = front + 2.0 * p.a1;
+    if front < 0.0 || back < 0.0 {
+        return false;
+    }
+    let (_, reach) = opw.shoulder_reach();
+    let up = nearest.z - p.c1;
+    let margin = 1e-6;
+    (front * front + up * up).sqrt() > reach + margin
+        && (back * back + up * up).sqrt() > reach + margin
 }
 
 /// Whether some exact IK solution of a robot-frame TCP pose keeps the arm and its tool above
@@ -527,6 +575,48 @@ fn solves_above_floor(cell: &Cell, pose: &Isometry3<f64>, tcp: &Isometry3<f64>) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_pose_pruned_as_beyond_reach_along_the_rail_is_out_of_reach_at_every_position() {
+        // Poses over and around a track cell's table, tool pointing down and tilted: wherever
+        // the prune says "beyond reach", the IK says so at every carriage position tried, and
+        // some poses are pruned and some not (the test is not vacuous).
+        let cell = Cell::load("study-abb-track").unwrap();
+        let track = cell.track.expect("a track cell");
+        let tcp = *cell.tool.tcp("grip").unwrap();
+        let (mut pruned, mut kept) = (0, 0);
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            let at = Vector3::new(next() * 8.0 - 2.0, next() * 8.0 - 4.0, next() * 1.5);
+            let turn = nalgebra::UnitQuaternion::from_euler_angles(
+                std::f64::consts::PI + (next() - 0.5) * 0.6,
+                (next() - 0.5) * 0.6,
+                next() * 6.0,
+            );
+            let pose = Isometry3::from_parts(Translation3::from(at), turn);
+            if !beyond_reach_along_the_rail(&cell, &track, &pose, &tcp) {
+                kept += 1;
+                continue;
+            }
+            pruned += 1;
+            let home = cell.robot.home();
+            for s in track.positions_from(0.0) {
+                let shift = track.base_at(s).inverse() * cell.robot_base;
+                let got = cell.robot.ik_branches(&(shift * pose), &tcp, &home);
+                assert!(
+                    matches!(got, Err(crate::cell::IkFailure::OutOfReach { .. })),
+                    "pruned, yet at s = {s} the IK gives {got:?} for {pose:?}"
+                );
+            }
+        }
+        assert!(pruned > 20 && kept > 20, "pruned {pruned}, kept {kept}");
+    }
 
     #[test]
     fn parts_reaching_the_same_keys_at_once_search_each_key_once() {
