@@ -237,15 +237,7 @@ fn the_classes_of_the_three_storey_model_on_the_abb_cell() {
 #[test]
 fn a_stud_modelled_proud_of_its_wall_comes_to_rest_off_target() {
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(example("tm3.ifc")).unwrap();
-    let at = "#139=IFCCARTESIANPOINT((1.1684,0.04445,0.0381));";
-    assert!(text.contains(at), "TM3's stud F-016 moved in the model");
-    let model = dir.path().join("tm3_stud_proud.ifc");
-    std::fs::write(
-        &model,
-        text.replace(at, "#139=IFCCARTESIANPOINT((1.1684,0.06445,0.0381));"),
-    )
-    .unwrap();
+    let model = common::ifc_edit::tm3_stud_moved(dir.path(), 0.020);
     // At offset_x 0.742 the arm reaches the stud: what fails is where it comes to rest.
     let classes = sweep(&model, "study-abb", &["--offset-x", "0.742"]);
     assert!(

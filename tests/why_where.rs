@@ -9,23 +9,10 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 use common::framewright_ok as framewright;
+use common::ifc_edit::tm3_stud_moved;
 
 fn tm3() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc")
-}
-
-/// TM3 with stud F-016 (#145) modelled `dy` m across the wall from where it is.
-fn tm3_stud_moved(dir: &Path, dy: f64) -> PathBuf {
-    let text = std::fs::read_to_string(tm3()).unwrap();
-    let at = "#139=IFCCARTESIANPOINT((1.1684,0.04445,0.0381));";
-    assert!(text.contains(at), "TM3's stud F-016 moved in the model");
-    let moved = text.replace(
-        at,
-        &format!("#139=IFCCARTESIANPOINT((1.1684,{},0.0381));", 0.04445 + dy),
-    );
-    let path = dir.join("tm3_stud_moved.ifc");
-    std::fs::write(&path, moved).unwrap();
-    path
 }
 
 /// The framing cause `why --json` gives for the one element.

@@ -1,7 +1,7 @@
 //! Small edits of the synthetic models' IFC text: the tests move a stud and see what follows.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Writes a 20 m wall with a window at 5 m, its members grouped in an IfcWall: three panels on
 /// a cell that carries 7.5 m.
@@ -58,4 +58,20 @@ pub fn stud_points(text: &str) -> Vec<String> {
             inside(&axis).split(',').next().unwrap().trim().to_string()
         })
         .collect()
+}
+
+/// TM3 (`examples/models/tm3.ifc`) with stud F-016 (#145) modelled `dy` m across the wall from
+/// where it is, written into `dir`.
+pub fn tm3_stud_moved(dir: &Path, dy: f64) -> PathBuf {
+    let tm3 = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/tm3.ifc");
+    let text = std::fs::read_to_string(tm3).unwrap();
+    let at = "#139=IFCCARTESIANPOINT((1.1684,0.04445,0.0381));";
+    assert!(text.contains(at), "TM3's stud F-016 moved in the model");
+    let moved = text.replace(
+        at,
+        &format!("#139=IFCCARTESIANPOINT((1.1684,{},0.0381));", 0.04445 + dy),
+    );
+    let path = dir.join("tm3_stud_moved.ifc");
+    std::fs::write(&path, moved).unwrap();
+    path
 }
