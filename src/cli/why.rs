@@ -399,11 +399,7 @@ fn check_piece_moves(
                     .find(|s| s.stage == "framing")
                     .map_or("not simulated", |s| s.status.as_str());
                 if status == "framed" {
-                    remedy.checked = true;
-                    remedy.text = match remedy.text.split_once("; not checked") {
-                        Some((head, _)) => head.to_string(),
-                        None => remedy.text.clone(),
-                    } + "; checked by simulating the wall again with the piece moved: framed";
+                    remedy.checked_by_simulation();
                     kept.push(remedy);
                 } else {
                     cause.no_remedy.push(format!(

@@ -58,6 +58,21 @@ pub struct Remedy {
     pub piece_move: Option<PieceMove>,
 }
 
+/// How an unchecked piece move says so; `checked_by_simulation` replaces it.
+const UNCHECKED_MOVE: &str =
+    "; not checked: computed from the gap measured beneath it at the release";
+
+impl Remedy {
+    /// Marks a piece move checked by a new simulation of its wall in which the piece framed.
+    pub fn checked_by_simulation(&mut self) {
+        self.checked = true;
+        self.text = self.text.replace(
+            UNCHECKED_MOVE,
+            "; checked by simulating the wall again with the piece moved: framed",
+        );
+    }
+}
+
 /// A piece moved in the model.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct PieceMove {
@@ -362,7 +377,7 @@ fn off_target_remedy(
         unit: "m",
         checked: false,
         text: format!(
-            "model it {:.1} mm nearer the surface beneath it as the wall lies ({below}){model_move}: its framing target lies that far above it, so it drops when released; not checked: computed from the gap measured beneath it at the release",
+            "model it {:.1} mm nearer the surface beneath it as the wall lies ({below}){model_move}: its framing target lies that far above it, so it drops when released{UNCHECKED_MOVE}",
             excess * 1000.0
         ),
         piece_move: by.map(|b| PieceMove {
