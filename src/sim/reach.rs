@@ -198,9 +198,15 @@ pub fn touch(
         let Some(body) = body_pose(parent) else {
             continue;
         };
-        let local = collider
-            .position_wrt_parent()
-            .map_or_else(Isometry3::identity, super::physics::to_iso);
+        // With a piece held, the jaws stand closed on its thickness (the jaws close across
+        // the piece's z, as `set_jaws` does), wherever they stand in the world now.
+        let local = held
+            .and_then(|(_, _, half)| phys.finger_at(c, 2.0 * half[2]))
+            .unwrap_or_else(|| {
+                collider
+                    .position_wrt_parent()
+                    .map_or_else(Isometry3::identity, super::physics::to_iso)
+            });
         let filter = QueryFilter::default()
             .groups(collider.collision_groups())
             .predicate(&predicate);

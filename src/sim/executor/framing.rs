@@ -16,10 +16,10 @@ use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vecto
 
 /// Height above the pick and place poses the gripper approaches from (m).
 pub(super) const CLEARANCE: f64 = 0.25;
-/// A piece more than this far from where the plan expected it when the jaws close is not
-/// held (m).
 /// Samples checked along a straight descent while planning.
 const LINE_SAMPLES: usize = 10;
+/// A piece more than this far from where the plan expected it when the jaws close is not
+/// held (m).
 pub(super) const GRIP_TOLERANCE: f64 = 0.005;
 /// A piece that ran into the sensor's end stop settles this long before the robot plans its
 /// grip (s).
@@ -636,7 +636,13 @@ impl<'a> WallRun<'a> {
                     let held_in_tool = grip * in_body.inverse();
                     let half = piece.size.map(|v| v / 2.0);
                     let held = Some((piece.id.as_str(), &held_in_tool, half));
-                    if let Some(t) = touch(&self.phys, &at_place, &q_place, held, &[], 0.0) {
+                    // Holding the piece at its target (the jaws closed on it), then letting
+                    // it go (the jaws open: a finger may meet a piece placed beside it).
+                    let at_target =
+                        touch(&self.phys, &at_place, &q_place, held, &[], 0.0).or_else(|| {
+                            touch(&self.phys, &at_place, &q_place, None, &[&piece.id], 0.0)
+                        });
+                    if let Some(t) = at_target {
                         return Err(Miss::colliding(Op::Place, t));
                     }
                     if let Some(t) = touch(&self.phys, &at_pick, &q_pick, None, &[&piece.id], 0.0) {

@@ -45,6 +45,15 @@ impl Physics {
         }
     }
 
+    /// A finger's pose in tool0 with the jaws standing `width` apart; None for any other
+    /// collider.
+    pub fn finger_at(&self, c: ColliderHandle, width: f64) -> Option<Isometry3<f64>> {
+        self.fingers
+            .iter()
+            .find(|f| f.collider == c)
+            .map(|f| f.offset(width))
+    }
+
     /// Runs the nailer out on its slide (`true`: where the tool file places it) or back.
     pub fn set_nailer(&mut self, out: bool) {
         if self.nailer.is_empty() || self.nailer_out == out {
