@@ -1,7 +1,6 @@
-//! The study's cells with a real wall's pieces: short cripples stay on edge at the end stop
-//! (the pick belt's slow end section), and a piece whose jaws would meet a placed neighbour
-//! (closed on it, or opening to let it go) is refused when its framing is planned, before the
-//! arm moves, instead of being driven into the neighbour.
+//! The study's cells with a real wall's pieces: a piece whose jaws would meet a placed
+//! neighbour (closed on it, or opening to let it go) is refused when its framing is planned,
+//! before the arm moves, instead of being driven into the neighbour.
 
 mod common;
 
@@ -12,8 +11,8 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
 }
 
-/// The bundled wall with a door and a window: its 60 mm cripples (under the sill) and king
-/// studs set face to face against their jacks.
+/// The bundled wall with a door and a window: king studs set face to face against their
+/// jacks.
 fn wall() -> PathBuf {
     root().join("tests/fixtures/synth_wall_door_window_in.ifc")
 }
@@ -50,41 +49,6 @@ fn reasons(sim: &Value) -> Vec<(String, String, String)> {
                 })
         })
         .collect()
-}
-
-#[test]
-fn short_cripples_stay_on_edge_on_the_study_cells_and_topple_without_the_slow_section() {
-    let model = wall();
-    for cell in ["study-abb", "study-kuka"] {
-        let toppled: Vec<_> = reasons(&simulate(&model, cell))
-            .into_iter()
-            .filter(|(_, _, m)| m.contains("toppled"))
-            .collect();
-        assert!(toppled.is_empty(), "{cell}: {toppled:?}");
-    }
-    // The same cell without its slow end section: the 60 mm cripples tip over at the stop,
-    // so the section is what keeps them on edge.
-    let text = std::fs::read_to_string(root().join("robots/cells/study-abb.toml")).unwrap();
-    let without: String = text
-        .lines()
-        .filter(|l| !l.starts_with("creep_"))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    assert_ne!(
-        without, text,
-        "study-abb's pick belt has a slow end section"
-    );
-    let dir = tempfile::tempdir().unwrap();
-    let cell = dir.path().join("study-abb-no-creep.toml");
-    std::fs::write(&cell, without).unwrap();
-    let toppled: Vec<_> = reasons(&simulate(&model, cell.to_str().unwrap()))
-        .into_iter()
-        .filter(|(_, role, m)| role == "cripple_stud" && m.contains("toppled"))
-        .collect();
-    assert!(
-        !toppled.is_empty(),
-        "nothing toppled without the slow section"
-    );
 }
 
 #[test]
