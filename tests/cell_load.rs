@@ -327,8 +327,9 @@ fn a_gripper_holding_the_top_face_has_pads_and_no_jaws() {
     assert!(msg.contains("stroke") && msg.contains("sides"), "{msg}");
 }
 
-/// A slow end section of conveyor 2 needs both its speed (below the belt's) and its length
-/// (within the belt); the line has one.
+/// A slow-down of conveyor 2 needs both its speed (below the belt's) and its length (within
+/// the belt); the line and the study's cells have one, a belt without the keys runs at one
+/// speed.
 #[test]
 fn a_creep_section_needs_its_speed_and_length_within_the_belt() {
     let line = Cell::load("framing-line").unwrap();
@@ -337,8 +338,23 @@ fn a_creep_section_needs_its_speed_and_length_within_the_belt() {
         .creep
         .expect("the line's pick belt has a slow end");
     assert!(creep.speed < line.conveyor2.speed && creep.length <= line.conveyor2.length);
-    assert!(Cell::load("study-abb").unwrap().conveyor2.creep.is_none());
+    assert!(Cell::load("study-abb").unwrap().conveyor2.creep.is_some());
     let text = include_str!("../robots/cells/framing-line.toml");
+    let one_speed: String = text
+        .lines()
+        .filter(|l| !l.starts_with("creep_"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("one-speed.toml");
+    std::fs::write(&path, one_speed).unwrap();
+    assert!(
+        Cell::load(path.to_str().unwrap())
+            .unwrap()
+            .conveyor2
+            .creep
+            .is_none()
+    );
     for (from, to) in [
         ("creep_length = 0.6\n", ""),
         ("creep_speed = 0.3", "creep_speed = 2.5"),

@@ -163,12 +163,13 @@ pub struct Conveyor {
     pub width: f64,
     /// Belt speed, m/s.
     pub speed: f64,
-    /// A slow end section before the end stop, where the belt has one.
+    /// A slow-down before the end stop, where the belt has one.
     pub creep: Option<Creep>,
 }
 
-/// The last `length` of a belt before its downstream end runs at `speed`: lumber meets the end
-/// stop slowly (a short block arriving at full speed tips over against it).
+/// The whole belt runs at `speed` while a piece on it reaches into its last `length` before
+/// the downstream end: lumber meets the end stop slowly (a short block arriving at full speed
+/// tips over against it).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Creep {
     /// m/s

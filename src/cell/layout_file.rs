@@ -149,7 +149,8 @@ pub(super) struct Conveyor2Section {
     pub(super) width: f64,
     #[serde(default = "speed_2")]
     pub(super) speed: f64,
-    /// A slow end section: the belt's last `creep_length` runs at `creep_speed`.
+    /// A slow-down: the belt runs at `creep_speed` while a piece reaches into its last
+    /// `creep_length`.
     pub(super) creep_speed: Option<f64>,
     pub(super) creep_length: Option<f64>,
 }

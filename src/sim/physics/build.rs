@@ -74,6 +74,7 @@ impl Physics {
                         k.speed as f32,
                     )
                 }),
+                now: c.speed as f32,
             });
             let frame_height = c.pose.translation.z - BELT_SLAB - f.z;
             if frame_height > 0.01 {

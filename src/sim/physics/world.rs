@@ -139,6 +139,8 @@ impl Physics {
     /// One physics step.
     pub fn step(&mut self) {
         self.bodies_may_move();
+        let dt = self.world.integration_parameters.dt;
+        self.belts.slow_down(&self.world, dt);
         self.world.step_with_events(&self.belts, &());
     }
 
