@@ -16,7 +16,6 @@ mod framing;
 mod nail_plan;
 mod nailing;
 mod paths;
-mod slide_in;
 mod stepping;
 
 pub use nail_plan::NailPlan;
