@@ -33,13 +33,13 @@ pub(super) const BELT_DECELERATION: f32 = 1.5;
 impl Belts {
     /// Before a step of `dt` s: a belt with a slow section slows down (at BELT_DECELERATION)
     /// while any body it carries reaches within the braking distance from full speed of that
-    /// section, and runs slow while one reaches into it, as a slow-down sensor ahead of an end stop switches
-    /// a belt's drive; otherwise it runs at its speed. Slowing only the section's own surface
-    /// would twist a piece spanning it.
+    /// section, and runs slow while one reaches into it, as a slow-down sensor ahead of an end
+    /// stop switches a belt's drive; otherwise it runs at its speed. Slowing only the section's
+    /// own surface would twist a piece spanning it.
     pub(super) fn slow_down(&mut self, world: &PhysicsWorld, dt: f32) {
         for belt in &mut self.belts {
+            // A belt without a slow section keeps the speed it was built with.
             let Some((end, length, creep)) = belt.creep else {
-                belt.now = belt.speed;
                 continue;
             };
             // From full speed down to the slow one, ending where the section starts.
