@@ -1,7 +1,7 @@
 //! The study's cells with a real wall's pieces: short cripples stay on edge at the end stop
 //! (the pick belt slows down before it), and a piece whose jaws would meet a placed neighbour
-//! (closed on it, or opening to let it go) is refused when its framing is planned, before the
-//! arm moves, instead of being driven into the neighbour.
+//! (closed on it, or opening to let it go) is let go beside its target and pushed in, instead
+//! of being driven into the neighbour.
 
 mod common;
 
@@ -122,31 +122,32 @@ fn lumber_riding_the_whole_pick_belt_is_slowed_without_tipping() {
 }
 
 #[test]
-fn jaws_that_would_meet_a_placed_neighbour_are_refused_at_the_plan_not_during_the_place() {
+fn face_to_face_studs_are_let_go_beside_their_neighbour_and_pushed_in() {
     let model = wall();
     for cell in ["study-abb", "study-kuka"] {
-        let all = reasons(&simulate(&model, cell));
-        // No finger is driven into anything while the arm places a piece.
-        let touched: Vec<_> = all
+        let sim = simulate(&model, cell);
+        let all = reasons(&sim);
+        // No finger is driven into anything while the arm places a piece, and none is
+        // refused for a finger meeting its neighbour: such a piece is slid in.
+        let finger: Vec<_> = all
             .iter()
-            .filter(|(_, _, m)| m.contains("finger touched") && m.contains("during place"))
+            .filter(|(_, _, m)| {
+                (m.contains("finger touched") && m.contains("during place"))
+                    || m.contains("finger with piece")
+            })
             .collect();
-        assert!(touched.is_empty(), "{cell}: {touched:?}");
-        // On the ABB the king studs beside their jacks are within reach: they are refused
-        // for the finger, naming the neighbour.
-        if cell == "study-abb" {
-            let refused: Vec<_> = all
-                .iter()
-                .filter(|(_, _, m)| {
-                    m.contains("place pose: every solution collides: tool gripper_")
-                })
-                .collect();
-            assert!(
-                refused
-                    .iter()
-                    .any(|(_, role, m)| role == "king_stud" && m.contains("finger with piece")),
-                "{cell}: {all:?}"
-            );
-        }
+        assert!(finger.is_empty(), "{cell}: {finger:?}");
+        // Every king stud of this wall stands face to face with its jack, so with jaws on
+        // its side faces none could be set down at its target; the framed ones were pushed
+        // in, and the as-built check (within 2 mm and 1 degree of the target) passed.
+        let framed_kings = sim["elements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|e| {
+                e["role"] == "king_stud" && e["framing"]["reasons"] == serde_json::json!([])
+            })
+            .count();
+        assert!(framed_kings >= 1, "{cell}: {all:?}");
     }
 }

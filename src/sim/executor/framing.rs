@@ -33,14 +33,14 @@ const RELEASE_LOOK_DOWN: f64 = 1.0;
 /// Why a framing could not be planned: the operation whose pose failed, how, and for a pose
 /// ruled out by a collision, where the two bodies met.
 pub(super) struct Miss {
-    op: Op,
-    failure: IkFailure,
+    pub(super) op: Op,
+    pub(super) failure: IkFailure,
     /// Boxed: a miss is passed around often, a touch rarely.
     touch: Option<Box<Touch>>,
 }
 
 impl Miss {
-    fn colliding(op: Op, t: Touch) -> Miss {
+    pub(super) fn colliding(op: Op, t: Touch) -> Miss {
         Miss {
             op,
             failure: IkFailure::AllSolutionsCollide {
@@ -62,7 +62,7 @@ impl From<(Op, IkFailure)> for Miss {
 }
 
 /// A planned framing: the grip and the joint values of its four poses.
-struct FramingPlan {
+pub(super) struct FramingPlan {
     pick: Isometry3<f64>,
     place: Isometry3<f64>,
     q_above_pick: Vec<f64>,
@@ -71,11 +71,15 @@ struct FramingPlan {
     place_margin: f64,
     /// The piece's body pose the pick was planned on.
     pick_body: Isometry3<f64>,
-    /// The target orientation actually used (a box has four equivalent ones).
-    target: Isometry3<f64>,
+    /// The target orientation actually used (a box has four equivalent ones), where the piece
+    /// is let go (beside its target, for a piece slid into place after).
+    pub(super) target: Isometry3<f64>,
     /// Where the carriage stands (on a track) to pick and to place.
     carriage_pick: f64,
-    carriage_place: f64,
+    pub(super) carriage_place: f64,
+    /// After the release: the push that slides the piece into face contact with its
+    /// neighbour (`slide_in.rs`).
+    pub(super) push: Option<super::slide_in::Push>,
 }
 
 impl<'a> WallRun<'a> {
@@ -134,7 +138,10 @@ impl<'a> WallRun<'a> {
             self.take_off(&piece.id);
             return;
         }
-        let plan = match self.plan_framing(piece) {
+        let plan = match self
+            .plan_framing(piece, &Vector3::zeros())
+            .or_else(|miss| self.plan_slide_in(piece, miss))
+        {
             Ok(plan) => plan,
             Err(miss) => {
                 self.record_miss(piece, miss);
@@ -334,10 +341,14 @@ impl<'a> WallRun<'a> {
             &grip,
         );
         self.end(id, Op::Retract, start);
+        let (ok, target) = match &plan.push {
+            Some(push) if ok => (self.slide_in(piece, push), push.target),
+            _ => (ok, plan.target),
+        };
         if ok {
             // Settled on the fixture: from now on the fixture holds it.
             self.phys.clamp(id);
-            self.placed.insert(id.to_string(), plan.target);
+            self.placed.insert(id.to_string(), target);
             // A pre-assembled member's other plies are in place with it.
             for ply in &piece.plies {
                 self.placed.insert(ply.id.clone(), ply.target_cell);
@@ -404,7 +415,7 @@ impl<'a> WallRun<'a> {
 
     /// A straight move of a framing that failed on the way: recorded against the piece, so
     /// that it is not placed without a reason.
-    fn record_line_failure(&mut self, piece: &ScenePiece, op: Op, failure: IkFailure) {
+    pub(super) fn record_line_failure(&mut self, piece: &ScenePiece, op: Op, failure: IkFailure) {
         self.record_miss(piece, Miss::from((op, failure)));
     }
 
@@ -558,8 +569,13 @@ impl<'a> WallRun<'a> {
     /// Chooses the grip (which way round the tool holds the piece) and the target orientation
     /// (a box fits its target four ways) whose pick and place poses the arm reaches, preferring
     /// a tool pointing down, poses clear of other bodies and short joint travel. Err: the
-    /// operation and failure of the closest miss.
-    fn plan_framing(&self, piece: &ScenePiece) -> Result<FramingPlan, Miss> {
+    /// operation and failure of the closest miss. `aside` (m, cell frame) moves the target
+    /// (where a piece is let go beside its target to be slid in).
+    pub(super) fn plan_framing(
+        &self,
+        piece: &ScenePiece,
+        aside: &Vector3<f64>,
+    ) -> Result<FramingPlan, Miss> {
         let grip = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
         let body = self.phys.lumber_pose(&piece.id).unwrap_or(piece.spawn);
         let along = self.cell.conveyor2.direction();
@@ -584,7 +600,7 @@ impl<'a> WallRun<'a> {
             let pick = grip_pose(&body, piece, &along, shift, flip);
             let in_body = body.inverse() * pick;
             for symmetry in box_symmetries() {
-                let target = piece.target_cell * symmetry;
+                let target = Translation3::from(*aside) * piece.target_cell * symmetry;
                 let place = target * in_body;
                 let down = -(place.rotation * Vector3::z()).z;
                 if down < 0.5 && piece.on_edge {
@@ -659,6 +675,7 @@ impl<'a> WallRun<'a> {
                         target,
                         carriage_pick,
                         carriage_place,
+                        push: None,
                     })
                 })();
                 match attempt {

@@ -16,6 +16,7 @@ mod framing;
 mod nail_plan;
 mod nailing;
 mod paths;
+mod slide_in;
 mod stepping;
 
 pub use nail_plan::NailPlan;

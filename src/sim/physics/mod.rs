@@ -15,7 +15,7 @@ mod robot;
 mod world;
 
 pub use probe::Watch;
-pub use world::{GRAVITY, Physics, to_iso, to_pose};
+pub use world::{FINGER, GRAVITY, Physics, to_iso, to_pose};
 
 #[cfg(test)]
 mod tests;

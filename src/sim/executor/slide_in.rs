@@ -1,0 +1,215 @@
+//! Slide-in: jaws that hold a piece by its side faces put a finger between it and a neighbour
+//! it is to stand face to face with (a jack against its king stud). Such a piece is let go
+//! beside its target, as far out as the open jaws need, and the open jaws' leading finger then
+//! pushes it along the surface into face contact, low on its side so that it slides instead
+//! of tipping over.
+
+use super::framing::{CLEARANCE, FramingPlan, Miss};
+use super::{WallRun, raise};
+use crate::cell::{IkFailure, Jaws};
+use crate::sim::motion::LinearMove;
+use crate::sim::physics::FINGER;
+use crate::sim::reach::{continuous_line, touch};
+use crate::sim::record::Op;
+use crate::world::ScenePiece;
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+
+/// Room between the open jaws' finger and the neighbour when the piece is let go, and between
+/// the pushing finger and the piece before the push (m).
+const SLIDE_CLEARANCE: f64 = 0.005;
+/// How high above the surface under the piece the finger tips push (m). A push at height h
+/// tips a piece on edge once h exceeds half its thickness over the friction coefficient
+/// (19 mm / 0.6, about 32 mm, for a 2x4); a finger reaching down to here pushes at its tip.
+const PUSH_TIP_HEIGHT: f64 = 0.005;
+/// The push's speed (m/s): slow, as lumber pushed along a table.
+const PUSH_SPEED: f64 = 0.05;
+/// Samples checked along each straight move of the push while planning.
+const PUSH_SAMPLES: usize = 10;
+
+/// A planned push: grip-TCP poses above its start, at its start (the leading finger just
+/// short of the piece's far face), at its end (the piece at its target) and backed off, the
+/// joints above the start, and the piece's final target.
+pub(super) struct Push {
+    pub(super) target: Isometry3<f64>,
+    above: Isometry3<f64>,
+    start: Isometry3<f64>,
+    end: Isometry3<f64>,
+    back: Isometry3<f64>,
+    q_above: Vec<f64>,
+}
+
+impl<'a> WallRun<'a> {
+    /// Where the plan's miss is a jaw finger meeting a placed piece at the place pose: the
+    /// framing that lets the piece go beside its target (on the side away from that piece)
+    /// and pushes it in. Err: the push's miss where a piece let go beside its target could
+    /// not be pushed in, else the original miss.
+    pub(super) fn plan_slide_in(
+        &self,
+        piece: &ScenePiece,
+        miss: Miss,
+    ) -> Result<FramingPlan, Miss> {
+        let finger_on_piece = miss.op == Op::Place
+            && matches!(&miss.failure, IkFailure::AllSolutionsCollide { pair }
+                if pair[0].contains("finger") && pair[1].starts_with("piece "));
+        let jaws = self.cell.tool.gripper.as_ref().and_then(|g| g.jaws());
+        let (true, Some(jaws), true) = (finger_on_piece, jaws, piece.on_edge) else {
+            return Err(miss);
+        };
+        // The jaws close across the piece's z: the finger stands on that side.
+        let across = piece.target_cell.rotation * Vector3::z();
+        if across.z.abs() > 0.1 {
+            return Err(miss);
+        }
+        let across = Vector3::new(across.x, across.y, 0.0).normalize();
+        // The open jaws stand this far out from the piece's faces, their finger plate beyond.
+        let gap = FINGER + (jaws.open_width - piece.size[2]) / 2.0 + SLIDE_CLEARANCE;
+        let mut push_miss = None;
+        for towards in [across, -across] {
+            let shift = -towards * gap;
+            let Ok(mut plan) = self.plan_framing(piece, &shift) else {
+                continue;
+            };
+            let target = Translation3::from(-shift) * plan.target;
+            match self.plan_push(piece, &plan, target, &towards, gap, jaws) {
+                Ok(push) => {
+                    plan.push = Some(push);
+                    return Ok(plan);
+                }
+                Err(m) => {
+                    push_miss.get_or_insert(m);
+                }
+            }
+        }
+        // Where the piece could be let go beside its target but not pushed in, the push's miss
+        // says why; otherwise the first.
+        Err(push_miss.unwrap_or(miss))
+    }
+
+    /// The push from where `plan` lets the piece go to `target`, `towards` the neighbour:
+    /// the tool pointing down, its jaw axis along the push with the nailer (slid back) leading
+    /// over the pieces (or, where that fails, trailing), the leading finger's tip just above
+    /// the surface. Err: the first miss, where no grip-TCP position along the piece gives
+    /// moves the arm reaches clear of everything but the piece.
+    fn plan_push(
+        &self,
+        piece: &ScenePiece,
+        plan: &FramingPlan,
+        target: Isometry3<f64>,
+        towards: &Vector3<f64>,
+        gap: f64,
+        jaws: &Jaws,
+    ) -> Result<Push, Miss> {
+        let invalid = || Miss::from((Op::Place, IkFailure::InvalidPose));
+        let grip = *self.cell.tool.tcp("grip").ok_or_else(invalid)?;
+        let gripper = self.cell.tool.gripper.as_ref().ok_or_else(invalid)?;
+        let let_go = plan.target;
+        let half = piece.size.map(|v| v / 2.0);
+        let rotation = let_go.rotation;
+        let below: f64 = (0..3)
+            .map(|i| (rotation * Vector3::ith(i, 1.0)).z.abs() * half[i])
+            .sum();
+        let bottom = let_go.translation.z - below;
+        let down = -Vector3::z();
+        let facing = |x: Vector3<f64>| {
+            UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+                Matrix3::from_columns(&[x, down.cross(&x), down]),
+            ))
+        };
+        let along = rotation * Vector3::x();
+        let far_face = let_go.translation.vector - towards * half[2];
+        let reach = jaws.open_width / 2.0 + FINGER;
+        // Both grippers push a piece as long as their spacing; a shorter one is pushed by one
+        // gripper's finger at its middle, so it does not turn.
+        let offsets = if piece.size[0] >= gripper.spacing || gripper.count < 2 {
+            vec![0.0]
+        } else {
+            vec![gripper.spacing / 2.0, -gripper.spacing / 2.0]
+        };
+        let cell = self.cell_at(plan.carriage_place);
+        let mut miss = None;
+        // The tool's x (the nailer's side) towards the neighbour, then away from it.
+        let ways = [facing(*towards), facing(-towards)];
+        for (tool, offset) in ways
+            .into_iter()
+            .flat_map(|tool| offsets.iter().map(move |o| (tool, *o)))
+        {
+            let mut point = far_face - towards * (SLIDE_CLEARANCE + reach) + along * offset;
+            point.z = bottom + jaws.jaw_depth + PUSH_TIP_HEIGHT;
+            let start = Isometry3::from_parts(Translation3::from(point), tool);
+            let shifted = |pose: &Isometry3<f64>, by: Vector3<f64>| {
+                Isometry3::from_parts(Translation3::from(pose.translation.vector + by), tool)
+            };
+            let end = shifted(&start, towards * (gap + SLIDE_CLEARANCE));
+            let back = shifted(&end, -towards * SLIDE_CLEARANCE);
+            let above = raise(&start, CLEARANCE);
+            let lines = (|| {
+                let (q_above, q_start) =
+                    continuous_line(&cell, &self.q, &above, &start, &grip, PUSH_SAMPLES)?;
+                let (_, q_end) =
+                    continuous_line(&cell, &q_start, &start, &end, &grip, PUSH_SAMPLES)?;
+                let (_, q_back) = continuous_line(&cell, &q_end, &end, &back, &grip, 2)?;
+                continuous_line(&cell, &q_back, &back, &raise(&back, CLEARANCE), &grip, 4)?;
+                Ok::<_, IkFailure>((q_above, q_start, q_end))
+            })();
+            let (q_above, q_start, q_end) = match lines {
+                Ok(lines) => lines,
+                Err(failure) => {
+                    miss.get_or_insert(Miss::from((Op::Place, failure)));
+                    continue;
+                }
+            };
+            // The piece is not there yet: only what else the tool would meet counts.
+            if let Some(t) = [&q_start, &q_end]
+                .iter()
+                .find_map(|q| touch(&self.phys, &cell, q, None, &[&piece.id], 0.0))
+            {
+                miss.get_or_insert(Miss::colliding(Op::Place, t));
+                continue;
+            }
+            return Ok(Push {
+                target,
+                above,
+                start,
+                end,
+                back,
+                q_above,
+            });
+        }
+        Err(miss.unwrap_or_else(|| Miss::from((Op::Place, IkFailure::InvalidPose))))
+    }
+
+    /// Runs a planned push after the piece was let go beside its target. Whether the piece
+    /// was pushed in (a failure on the way is recorded against it).
+    pub(super) fn slide_in(&mut self, piece: &ScenePiece, push: &Push) -> bool {
+        let Some(grip) = self.cell.tool.tcp("grip").copied() else {
+            return false;
+        };
+        let id = piece.id.as_str();
+        let start = self.begin(id, Op::Place, &[]);
+        let (speed, accel) = (self.approach_speed(), self.cell.motion.line_accel);
+        let lift = raise(&push.back, CLEARANCE);
+        let moved = self
+            .move_to(&push.q_above.clone(), &grip, &[], self.transfer_speed())
+            .and_then(|()| {
+                self.run_line(
+                    &LinearMove::new(push.above, push.start, speed, accel),
+                    &grip,
+                )
+            })
+            .and_then(|()| {
+                self.run_line(
+                    &LinearMove::new(push.start, push.end, PUSH_SPEED.min(speed), accel),
+                    &grip,
+                )
+            })
+            .and_then(|()| self.run_line(&LinearMove::new(push.back, lift, speed, accel), &grip));
+        self.end(id, Op::Place, start);
+        match moved {
+            Ok(()) => true,
+            Err(failure) => {
+                self.record_line_failure(piece, Op::Place, failure);
+                false
+            }
+        }
+    }
+}
