@@ -202,6 +202,9 @@ impl<'a> WallRun<'a> {
                     &grip,
                 )
             })
+            .and_then(|()| {
+                self.run_line(&LinearMove::new(push.end, push.back, speed, accel), &grip)
+            })
             .and_then(|()| self.run_line(&LinearMove::new(push.back, lift, speed, accel), &grip));
         self.end(id, Op::Place, start);
         match moved {
