@@ -856,12 +856,12 @@ fn a_signal_of_the_other_language_is_refused_and_nothing_is_written() {
     assert!(!out.exists(), "nothing written");
 }
 
-/// The line's nailer rides back on a slide while the tool frames: its program runs the slide
-/// out before nailing and back after, and fires only with the slide out. The study's tool has
-/// no slide and its programs drive no slide signal.
+/// A nailer on a slide (the line's tool and the study's) rides back while the tool frames:
+/// its program runs the slide out before nailing and back after, and fires only with the
+/// slide out.
 #[test]
 fn the_nailer_fires_only_with_its_slide_out() {
-    for (cell, slide) in [("framing-line", true), ("study-abb", false)] {
+    for cell in ["framing-line", "study-abb"] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("out");
         run(&[
@@ -885,12 +885,12 @@ fn the_nailer_fires_only_with_its_slide_out() {
                     "SetDO doNailerSlide, 0;" => (slide_out, moved) = (false, true),
                     "SetDO doNailerFire, 1;" => {
                         fired += 1;
-                        assert_eq!(slide_out, slide, "{cell}: fired with the slide out");
+                        assert!(slide_out, "{cell}: fired with the slide back");
                     }
                     _ => {}
                 }
             }
-            assert_eq!(moved, slide, "{cell}: the slide signal");
+            assert!(moved, "{cell}: no slide signal");
             assert!(!slide_out, "{cell}: the program ends with the slide back");
         }
         assert!(fired > 0, "{cell}: nails fired");

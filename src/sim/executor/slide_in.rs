@@ -17,10 +17,12 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 /// Room between the open jaws' finger and the neighbour when the piece is let go, and between
 /// the pushing finger and the piece before the push (m).
 const SLIDE_CLEARANCE: f64 = 0.005;
-/// How high above the surface under the piece the finger tips push (m). A push at height h
-/// tips a piece on edge once h exceeds half its thickness over the friction coefficient
-/// (19 mm / 0.6, about 32 mm, for a 2x4); a finger reaching down to here pushes at its tip.
-const PUSH_TIP_HEIGHT: f64 = 0.005;
+/// How far the pushing finger leans back from the piece (rad, 3°): only the edge of its tip
+/// touches the piece, low on its side. Upright, the finger's whole face (60 mm deep) met the
+/// piece and the push could act anywhere up to 65 mm above the table, above the height that
+/// tips a piece on edge (half its thickness over the friction coefficient: 19 mm / 0.6, about
+/// 32 mm, for a 2x4): pushed pieces leaned, turned and stopped up to 16 mm off their targets.
+const PUSH_TILT: f64 = 3.0 * std::f64::consts::PI / 180.0;
 /// The push's speed (m/s): slow, as lumber pushed along a table.
 const PUSH_SPEED: f64 = 0.05;
 /// Samples checked along each straight move of the push while planning.
@@ -125,6 +127,14 @@ impl<'a> WallRun<'a> {
         } else {
             vec![gripper.spacing / 2.0, -gripper.spacing / 2.0]
         };
+        // Leaning back lowers the trailing finger (the jaws' opening and two fingers behind
+        // the tip edge): its tip stays SLIDE_CLEARANCE above the table, the pushing tip edge
+        // that much higher (15 mm for the study's jaws, well below the 32 mm that tips a 2x4).
+        let lean = UnitQuaternion::from_axis_angle(
+            &nalgebra::Unit::new_normalize(down.cross(towards)),
+            PUSH_TILT,
+        );
+        let tip_height = SLIDE_CLEARANCE + (jaws.open_width + 2.0 * FINGER) * PUSH_TILT.sin();
         let cell = self.cell_at(plan.carriage_place);
         let mut miss = None;
         // The tool's x (the nailer's side) towards the neighbour, then away from it.
@@ -134,10 +144,16 @@ impl<'a> WallRun<'a> {
             .flat_map(|tool| offsets.iter().map(move |o| (tool, *o)))
         {
             let mut point = far_face - towards * (SLIDE_CLEARANCE + reach) + along * offset;
-            point.z = bottom + jaws.jaw_depth + PUSH_TIP_HEIGHT;
-            let start = Isometry3::from_parts(Translation3::from(point), tool);
+            point.z = bottom + jaws.jaw_depth + tip_height;
+            let upright = Isometry3::from_parts(Translation3::from(point), tool);
+            // Leaning back about the leading finger's tip edge, which stays where it was.
+            let tip = point + towards * reach + down * jaws.jaw_depth;
+            let start = Translation3::from(tip) * lean * Translation3::from(-tip) * upright;
             let shifted = |pose: &Isometry3<f64>, by: Vector3<f64>| {
-                Isometry3::from_parts(Translation3::from(pose.translation.vector + by), tool)
+                Isometry3::from_parts(
+                    Translation3::from(pose.translation.vector + by),
+                    pose.rotation,
+                )
             };
             let end = shifted(&start, towards * (gap + SLIDE_CLEARANCE));
             let back = shifted(&end, -towards * SLIDE_CLEARANCE);

@@ -224,6 +224,8 @@ impl Physics {
                         };
                         let c = world.insert_collider(
                             ColliderBuilder::cuboid(half(FINGER), h[1] as f32, h[2] as f32)
+                                .friction(FINGER_FRICTION)
+                                .friction_combine_rule(CoefficientCombineRule::Min)
                                 .position(to_pose(&finger.offset(open)))
                                 .collision_groups(groups(ROBOT, FIXED | LUMBER))
                                 .active_collision_types(robot_types),

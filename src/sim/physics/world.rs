@@ -38,6 +38,12 @@ pub(super) fn groups(member: Group, filter: Group) -> InteractionGroups {
 /// Lumber friction against the belts, the floor and other lumber.
 pub(super) const LUMBER_FRICTION: f32 = 0.6;
 pub(super) const BELT_FRICTION: f32 = 0.8;
+/// Friction of the jaw fingers' steel faces against lumber: dry wood on metal runs about
+/// 0.2-0.6 in published tables; 0.3 (estimate). Combined by the lower of the two, so that it
+/// is what a finger meets on lumber. Left at rapier's default (0.5, averaged with the
+/// lumber's to 0.55), a finger pushing a jack along the table rolled it onto its leading edge
+/// and turned it, and it came to rest 13-16 mm short of its king.
+pub(super) const FINGER_FRICTION: f32 = 0.3;
 /// Thickness of a belt slab under its top surface.
 pub(super) const BELT_SLAB: f64 = 0.10;
 /// Conveyor 2's belt lies this much below its nominal height: lumber sliding across a seam
