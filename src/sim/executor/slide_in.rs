@@ -6,7 +6,7 @@
 
 use super::framing::{CLEARANCE, FramingPlan, Miss};
 use super::{WallRun, raise};
-use crate::cell::{IkFailure, Jaws};
+use crate::cell::{Gripper, IkFailure, Jaws};
 use crate::sim::motion::LinearMove;
 use crate::sim::physics::FINGER;
 use crate::sim::reach::{continuous_line, touch};
@@ -53,8 +53,11 @@ impl<'a> WallRun<'a> {
         let finger_on_piece = miss.op == Op::Place
             && matches!(&miss.failure, IkFailure::AllSolutionsCollide { pair }
                 if pair[0].contains("finger") && pair[1].starts_with("piece "));
-        let jaws = self.cell.tool.gripper.as_ref().and_then(|g| g.jaws());
-        let (true, Some(jaws), true) = (finger_on_piece, jaws, piece.on_edge) else {
+        let gripper = self.cell.tool.gripper.as_ref();
+        let jaws = gripper.and_then(|g| g.jaws());
+        let (true, Some(gripper), Some(jaws), true) =
+            (finger_on_piece, gripper, jaws, piece.on_edge)
+        else {
             return Err(miss);
         };
         // The jaws close across the piece's z: the finger stands on that side.
@@ -72,7 +75,7 @@ impl<'a> WallRun<'a> {
                 continue;
             };
             let target = Translation3::from(-shift) * plan.target;
-            match self.plan_push(piece, &plan, target, &towards, gap, jaws) {
+            match self.plan_push(piece, &plan, target, &towards, gap, (gripper, jaws)) {
                 Ok(push) => {
                     plan.push = Some(push);
                     return Ok(plan);
@@ -99,11 +102,9 @@ impl<'a> WallRun<'a> {
         target: Isometry3<f64>,
         towards: &Vector3<f64>,
         gap: f64,
-        jaws: &Jaws,
+        (gripper, jaws): (&Gripper, &Jaws),
     ) -> Result<Push, Miss> {
-        let invalid = || Miss::from((Op::Place, IkFailure::InvalidPose));
-        let grip = *self.cell.tool.tcp("grip").ok_or_else(invalid)?;
-        let gripper = self.cell.tool.gripper.as_ref().ok_or_else(invalid)?;
+        let grip = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
         let let_go = plan.target;
         let half = piece.size.map(|v| v / 2.0);
         let rotation = let_go.rotation;
@@ -149,14 +150,8 @@ impl<'a> WallRun<'a> {
             // Leaning back about the leading finger's tip edge, which stays where it was.
             let tip = point + towards * reach + down * jaws.jaw_depth;
             let start = Translation3::from(tip) * lean * Translation3::from(-tip) * upright;
-            let shifted = |pose: &Isometry3<f64>, by: Vector3<f64>| {
-                Isometry3::from_parts(
-                    Translation3::from(pose.translation.vector + by),
-                    pose.rotation,
-                )
-            };
-            let end = shifted(&start, towards * (gap + SLIDE_CLEARANCE));
-            let back = shifted(&end, -towards * SLIDE_CLEARANCE);
+            let end = Translation3::from(towards * (gap + SLIDE_CLEARANCE)) * start;
+            let back = Translation3::from(-towards * SLIDE_CLEARANCE) * end;
             let above = raise(&start, CLEARANCE);
             let lines = (|| {
                 let (q_above, q_start) =
@@ -197,15 +192,13 @@ impl<'a> WallRun<'a> {
     /// Runs a planned push after the piece was let go beside its target. Whether the piece
     /// was pushed in (a failure on the way is recorded against it).
     pub(super) fn slide_in(&mut self, piece: &ScenePiece, push: &Push) -> bool {
-        let Some(grip) = self.cell.tool.tcp("grip").copied() else {
-            return false;
-        };
+        let grip = *self.cell.tool.tcp("grip").expect("cells have a grip TCP");
         let id = piece.id.as_str();
         let start = self.begin(id, Op::Place, &[]);
         let (speed, accel) = (self.approach_speed(), self.cell.motion.line_accel);
         let lift = raise(&push.back, CLEARANCE);
         let moved = self
-            .move_to(&push.q_above.clone(), &grip, &[], self.transfer_speed())
+            .move_to(&push.q_above, &grip, &[], self.transfer_speed())
             .and_then(|()| {
                 self.run_line(
                     &LinearMove::new(push.above, push.start, speed, accel),
