@@ -12,7 +12,7 @@ use crate::sim::physics::FINGER;
 use crate::sim::reach::{continuous_line, touch};
 use crate::sim::record::Op;
 use crate::world::ScenePiece;
-use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// Room between the open jaws' finger and the neighbour when the piece is let go, and between
 /// the pushing finger and the piece before the push (m).
@@ -23,6 +23,14 @@ const SLIDE_CLEARANCE: f64 = 0.005;
 /// tips a piece on edge (half its thickness over the friction coefficient: 19 mm / 0.6, about
 /// 32 mm, for a 2x4): pushed pieces leaned, turned and stopped up to 16 mm off their targets.
 const PUSH_TILT: f64 = 3.0 * std::f64::consts::PI / 180.0;
+/// How far from a placed piece its end abuts a pushed piece is let go (m). Let go flush, the
+/// piece's end slides along that piece's side and its leading corner meets that piece's end
+/// edge-on with no gap either way: the contact could take the end as a wall across the push,
+/// and a door jack pushed along its bottom plate's end pivoted on it and stopped turned 1°,
+/// 4-5 mm off. The clearance stays in the as-built error (within the 2 mm tolerance).
+const END_CLEARANCE: f64 = 0.001;
+/// How far beyond a piece's end face another piece counts as abutting it (m).
+const ABUT_PROBE: f64 = 5e-4;
 /// The push's speed (m/s): slow, as lumber pushed along a table.
 const PUSH_SPEED: f64 = 0.05;
 /// Samples checked along each straight move of the push while planning.
@@ -68,9 +76,10 @@ impl<'a> WallRun<'a> {
         let across = Vector3::new(across.x, across.y, 0.0).normalize();
         // The open jaws stand this far out from the piece's faces, their finger plate beyond.
         let gap = FINGER + (jaws.open_width - piece.size[2]) / 2.0 + SLIDE_CLEARANCE;
+        let clear_of_end = self.away_from_abutting_end(piece) * END_CLEARANCE;
         let mut push_miss = None;
         for towards in [across, -across] {
-            let shift = -towards * gap;
+            let shift = -towards * gap + clear_of_end;
             let Ok(mut plan) = self.plan_framing(piece, &shift) else {
                 continue;
             };
@@ -88,6 +97,37 @@ impl<'a> WallRun<'a> {
         // Where the piece could be let go beside its target but not pushed in, the push's miss
         // says why; otherwise the first.
         Err(push_miss.unwrap_or(miss))
+    }
+
+    /// The unit direction along `piece` away from the placed piece one of its ends abuts at
+    /// its target (probed just beyond the end face, over its width and thickness); zero
+    /// where neither end or both ends abut.
+    fn away_from_abutting_end(&self, piece: &ScenePiece) -> Vector3<f64> {
+        let target = piece.target_cell;
+        let half = piece.size.map(|v| v / 2.0);
+        let inside_placed = |p: &Point3<f64>| {
+            self.placed.iter().any(|(id, pose)| {
+                let Some(size) = self.sizes.get(id) else {
+                    return false;
+                };
+                let local = pose.inverse() * p;
+                (0..3).all(|i| local[i].abs() < size[i] / 2.0)
+            })
+        };
+        let abuts = |side: f64| {
+            let x = side * (half[0] + ABUT_PROBE);
+            [-0.8, 0.0, 0.8].iter().any(|&fy| {
+                [-0.8, 0.0, 0.8].iter().any(|&fz| {
+                    inside_placed(&(target * Point3::new(x, fy * half[1], fz * half[2])))
+                })
+            })
+        };
+        let axis = target.rotation * Vector3::x();
+        match (abuts(1.0), abuts(-1.0)) {
+            (true, false) => -axis,
+            (false, true) => axis,
+            _ => Vector3::zeros(),
+        }
     }
 
     /// The push from where `plan` lets the piece go to `target`, `towards` the neighbour:
