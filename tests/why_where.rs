@@ -172,7 +172,7 @@ fn a_collision_names_both_bodies_where_they_are_and_how_deep() {
         return;
     };
     for (id, other) in [
-        ("1aNYXAT4z0NxKvdw4w9w12", "piece "),
+        ("04NmzTFAbBswOTSKeuD7NF", "piece "),
         ("33byu$rir8Qx9Gsa5Jzd8K", "floor"),
     ] {
         let cause = framing_cause(&model, id, &["--cell", "study-abb", "--no-cache"]);

@@ -425,7 +425,11 @@ impl Physics {
         deepest: &TrackedContact<ContactData>,
     ) -> Option<(f64, nalgebra::Point3<f64>)> {
         let colliders = &self.world.colliders;
-        let (c1, c2) = (&colliders[pair.collider1], &colliders[pair.collider2]);
+        // A pair of a collider just removed lasts until the next step.
+        let (c1, c2) = (
+            colliders.get(pair.collider1)?,
+            colliders.get(pair.collider2)?,
+        );
         let point = |v: Vector| nalgebra::Point3::new(v.x, v.y, v.z).cast::<f64>();
         match rapier3d::parry::query::contact(
             c1.position(),
