@@ -30,6 +30,9 @@ fn syntax_errors() {
     fails("p(x, y) :- e(x y).\n", 4, 16, "expected `)`");
     fails("p(x, y) :- e(x, \"y).\n", 4, 17, "unterminated string");
     fails("#include \"x.dl\"\n", 4, 1, "preprocessor");
+    // A string may hold line breaks (as in Soufflé): what follows it is placed by the
+    // lines it spans.
+    fails("p(x, y) :- e(x, y), x = \"a\nb\" y.\n", 5, 4, "expected");
 }
 
 #[test]

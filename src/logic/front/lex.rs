@@ -152,11 +152,13 @@ pub fn lex(file: u32, text: &str) -> Result<(Vec<Token>, Vec<Label>), LexError> 
             let mut j = i + 1;
             loop {
                 match chars.get(j) {
-                    None | Some('\n') => {
+                    None => {
+                        // Underlined to the end of its line.
+                        let shown = chars[i..].iter().take_while(|&&c| c != '\n').count();
                         return Err(LexError {
-                            span: span(line, col, j - i),
+                            span: span(line, col, shown),
                             message: "unterminated string".into(),
-                            hint: "close the string with `\"` on the same line".into(),
+                            hint: "close the string with `\"`".into(),
                         });
                     }
                     Some('"') => break,
@@ -189,11 +191,24 @@ pub fn lex(file: u32, text: &str) -> Result<(Vec<Token>, Vec<Label>), LexError> 
                 }
             }
             let len = j + 1 - i;
+            // A string may hold line breaks, as in Soufflé (its scanner's `[^"\\]` takes
+            // them): the token's span covers its first line, and the position moves on
+            // past the last.
+            let literal = &chars[i..=j];
+            let breaks = literal.iter().filter(|&&c| c == '\n').count();
+            let first_line = literal.iter().take_while(|&&c| c != '\n').count();
             toks.push(Token {
                 tok: Tok::Str(s),
-                span: span(line, col, len),
+                span: span(line, col, first_line),
             });
-            advance(len, &mut i, &mut col);
+            if breaks == 0 {
+                advance(len, &mut i, &mut col);
+            } else {
+                let after_last = literal.iter().rev().take_while(|&&c| c != '\n').count();
+                i += len;
+                line += breaks as u32;
+                col = after_last as u32 + 1;
+            }
             continue;
         }
         if c.is_ascii_digit() {
