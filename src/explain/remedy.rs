@@ -116,7 +116,7 @@ pub fn remedies(cell: &Cell, failed: &FailedPlace) -> Remedies {
     };
     if held(cell, Vector3::zeros()).is_some() {
         out.none_found.push(
-            "none searched: the place pose solves as modelled by the check remedies are verified by (IK, joint limits, floor, tool pointing down), so what refused it lies beyond that check (the executor's own collision test against the floor, the cell's fixtures or placed pieces, or its grip)".into(),
+            "none searched: the place pose passes the check remedies are verified by (IK, joint limits, floor, tool pointing down), so what refused it lies beyond that check: the executor's collision test of the arm and tool against the floor, the cell's fixtures and placed pieces, or its grip".into(),
         );
         return out;
     }
